@@ -1,0 +1,80 @@
+/* jkr/dt: per-contact state, keyed by the pair of atom IDs.
+
+   Every bonded contact is stored twice, once with each of its two atoms,
+   as (partner ID, per-contact values). The storage is per atom, so it moves
+   with its atom between MPI ranks (pack/unpack_exchange), follows atom
+   sorting (copy_arrays) and goes into restart files (pack/unpack_restart).
+   The pair style creates this fix and is the only writer.
+
+   Per-contact values are laid out by "fields" that the pair style switches
+   on only when some type pair needs them, so a channel that is off stores
+   nothing. Values of a contact are kept in the canonical orientation of the
+   pair (the atom with the smaller ID is "particle 1"), so both copies are
+   identical.
+
+   Each atom also keeps a ledger of the energy dissipated in its contacts,
+   one column per channel; half of each contact's dissipation goes to each of
+   its two atoms. The ledger sums to the dissipated energies of
+   compute pair jkr/dt, survives migration and restarts, and is the fix's
+   per-atom array.                                                          */
+
+#ifndef JKR_DT_FIX_CONTACTS_H
+#define JKR_DT_FIX_CONTACTS_H
+
+#include "fix.h"
+
+namespace LAMMPS_NS {
+
+class FixJKRDTContacts : public Fix {
+ public:
+  // per-contact value fields, each present only when its bit is in the layout mask
+  enum Field { DAMPING_FORCE = 0, NFIELD };
+  static constexpr int FIELD_SIZE[NFIELD] = {1};
+
+  // ledger columns: energy dissipated by channel
+  enum Ledger { FORM_BREAK = 0, DAMPING, SLIDING, ROLLING, TWISTING, NLEDGER };
+
+  FixJKRDTContacts(class LAMMPS *, int, char **);
+  ~FixJKRDTContacts() override;
+  int setmask() override { return 0; }
+
+  void set_layout(int mask);
+  int layout_mask() const { return mask; }
+  bool has_field(Field f) const { return (mask >> f) & 1; }
+  int offset(Field f) const { return field_offset[f]; }
+
+  int find(int i, tagint partner_tag) const;
+  double *add(int i, tagint partner_tag);
+  void remove(int i, int k);
+  double *contact_values(int i, int k) { return values[i] + k * dnum; }
+
+  void grow_arrays(int) override;
+  void copy_arrays(int, int, int) override;
+  void set_arrays(int) override;
+  int pack_exchange(int, double *) override;
+  int unpack_exchange(int, double *) override;
+  int pack_restart(int, double *) override;
+  void unpack_restart(int, int) override;
+  int size_restart(int) override;
+  int maxsize_restart() override;
+  double memory_usage() override;
+
+  int *npartner;        // number of bonded contacts of each atom
+  tagint **partner;     // atom IDs of the partners
+  double **values;      // per-contact values, dnum per contact
+  double **ledger;      // dissipated energy by channel, NLEDGER per atom
+  int dnum;             // doubles per contact under the current layout
+
+ private:
+  int mask;             // bit f set = field f stored
+  int field_offset[NFIELD];
+  int maxpartner;       // row capacity of partner/values on this rank
+  int nmax_alloc;       // rows allocated in the per-atom arrays
+
+  void grow_partner_capacity(int needed);
+  static int layout_size(int mask, int *offsets);
+};
+
+}    // namespace LAMMPS_NS
+
+#endif

@@ -1,0 +1,139 @@
+/* jkr/dt: the normal (JKR) interaction of Wada et al. (2007), section 2.1,
+   with the viscoelastic damping of Arakawa et al. as written in eq. (A.5)
+   of the 3D BPCA collision paper.
+
+   Stateless kernels: plain numbers in, plain numbers out. No LAMMPS types,
+   so the equations can be read, and tested, on their own.
+
+   Notation (Wada et al. 2007):
+     R        reduced radius,            1/R = 1/r1 + 1/r2              eq. (2)
+     E*       reduced Young's modulus,   1/E* = (1-nu1^2)/E1 + (...)2   eq. (2)
+     a0       equilibrium contact radius (9 pi gamma R^2 / E*)^(1/3)    eq. (1)
+     delta0   equilibrium compression    a0^2 / (3R)
+     delta_c  critical stretch           (9/16)^(1/3) delta0
+     F_c      pull-off force             3 pi gamma R
+   The kernels work with y = sqrt(a/a0), in which eq. (4) is a quartic
+   with no square roots, and x^(3/2) = y^3.                               */
+
+#ifndef JKR_DT_NORMAL_H
+#define JKR_DT_NORMAL_H
+
+#include <cmath>
+
+namespace JKRDT {
+
+/* ---------------------------------------------------------------------
+   constants
+------------------------------------------------------------------------ */
+
+constexpr double PI = 3.14159265358979323846;
+
+// delta_c / delta0 = (9/16)^(1/3)
+inline double delta_c_ratio() { return std::cbrt(9.0 / 16.0); }
+
+// y = sqrt(a/a0) at the break point: a/a0 = 6^(-2/3), where d(delta)/da = 0
+inline double y_break() { return 1.0 / std::cbrt(6.0); }
+
+// 4 * 6^(1/3): prefactor of U_n / (F_c delta_c), eq. (6)
+inline double potential_prefactor() { return 4.0 * std::cbrt(6.0); }
+
+/* ---------------------------------------------------------------------
+   scales of one contact, eqs. (1)-(2) and section 2.1
+------------------------------------------------------------------------ */
+
+struct NormalScales {
+  double R;        // reduced radius
+  double a0;       // equilibrium contact radius
+  double delta0;   // equilibrium compression length
+  double delta_c;  // critical stretch: contact breaks at delta < -delta_c
+  double F_c;      // pull-off force
+};
+
+// a0_coef = (9 pi gamma / E*)^(1/3), so that a0 = a0_coef * R^(2/3), eq. (1)
+inline double a0_coefficient(double gamma, double Estar)
+{
+  return std::cbrt(9.0 * PI * gamma / Estar);
+}
+
+inline NormalScales normal_scales(double r1, double r2, double gamma, double a0_coef)
+{
+  NormalScales s;
+  s.R = r1 * r2 / (r1 + r2);                      // eq. (2)
+  s.a0 = a0_coef * std::cbrt(s.R * s.R);          // eq. (1)
+  s.delta0 = s.a0 * s.a0 / (3.0 * s.R);           // below eq. (4)
+  s.delta_c = delta_c_ratio() * s.delta0;         // below eq. (5)
+  s.F_c = 3.0 * PI * gamma * s.R;                 // below eq. (5)
+  return s;
+}
+
+/* ---------------------------------------------------------------------
+   contact radius: invert eq. (4)
+   delta/delta0 = 3 (a/a0)^2 - 2 (a/a0)^(1/2)  <=>  3 y^4 - 2 y - d = 0
+
+   For d >= -delta_c/delta0 the stable branch is the largest root,
+   y >= y_break. f(y) = 3y^4 - 2y - d is convex and increasing there, so
+   Newton's method started from any y with f(y) >= 0 descends monotonically
+   onto the root. y0 = max(1, d^(1/4)) is such a start for every d:
+   d <= 1: f(1) = 1 - d >= 0;  d > 1: f(d^(1/4)) = 2d - 2 d^(1/4) > 0.
+   At d = -delta_c/delta0 the root is double and convergence is linear,
+   hence the generous iteration cap.
+------------------------------------------------------------------------ */
+
+inline double contact_sqrt_radius(double d)
+{
+  double y = (d > 1.0) ? std::sqrt(std::sqrt(d)) : 1.0;
+  for (int iter = 0; iter < 200; ++iter) {
+    const double y3 = y * y * y;
+    const double f = 3.0 * y3 * y - 2.0 * y - d;
+    const double fprime = 12.0 * y3 - 2.0;
+    if (fprime <= 0.0) break;
+    const double step = f / fprime;
+    y -= step;
+    if (step <= 1.0e-15 * y) break;    // monotone descent: a non-positive step is the end
+  }
+  const double yb = y_break();
+  return (y < yb) ? yb : y;
+}
+
+/* ---------------------------------------------------------------------
+   force and potential along the normal
+------------------------------------------------------------------------ */
+
+// F / F_c = 4 [ (a/a0)^3 - (a/a0)^(3/2) ] = 4 y^3 (y^3 - 1), eq. (5); > 0 is repulsive
+inline double normal_force_ratio(double y)
+{
+  const double y3 = y * y * y;
+  return 4.0 * y3 * (y3 - 1.0);
+}
+
+// U_n / (F_c delta_c) = 4 6^(1/3) [ 4/5 x^5 - 4/3 x^(7/2) + 1/3 x^2 ], x = y^2, eq. (6)
+inline double normal_potential_ratio(double y)
+{
+  const double y2 = y * y;
+  const double y4 = y2 * y2;
+  const double y3 = y2 * y;
+  return potential_prefactor() * y4 * (0.8 * y4 * y2 - (4.0 / 3.0) * y3 + 1.0 / 3.0);
+}
+
+// U_n at delta = 0, the jump at contact formation (~ -0.847 F_c delta_c)
+inline double potential_ratio_at_touch()
+{
+  return normal_potential_ratio(contact_sqrt_radius(0.0));
+}
+
+// U_n at delta = -delta_c, the jump at separation (~ 0.089 F_c delta_c)
+inline double potential_ratio_at_break() { return normal_potential_ratio(y_break()); }
+
+/* ---------------------------------------------------------------------
+   viscoelastic damping, eq. (A.5): F_D = 2 T_vis E* / nu^2 * a * v_rel
+   damping_coefficient() returns 2 T_vis E* / nu^2; multiply by a v_rel.
+------------------------------------------------------------------------ */
+
+inline double damping_coefficient(double tvis, double Estar, double nu)
+{
+  return 2.0 * tvis * Estar / (nu * nu);
+}
+
+}    // namespace JKRDT
+
+#endif

@@ -1,0 +1,391 @@
+/* jkr/dt: the neighbor-list loop, contact formation and breaking, and the
+   energy ledger.
+
+   Parallel layout. The style asks for a half neighbor list built as with
+   newton off, whatever the global newton setting: a pair with one ghost atom
+   is computed on both ranks, and each rank writes forces and contact state
+   only for its own atoms. Every contact is stored with both of its atoms, so
+   no reverse communication of contact state is ever needed. Each pair is
+   evaluated in its canonical orientation (particle 1 = smaller atom ID), so
+   the two ranks do the same arithmetic on the same numbers.
+
+   Energy. pe holds the contact potentials U_n, eq. (6). The energy that
+   leaves the mechanical budget is booked per channel in the contact fix's
+   per-atom ledger, half to each atom of the contact:
+     formation  -U_n(delta) at the step the contact forms (the jump of pe)
+     breaking   U_n(-delta_c) when delta drops below -delta_c
+     damping    the work of F_D of eq. (A.5) across the two half-kicks of
+                velocity Verlet that apply it: F_D(n) (v_rel(n-1/2) + v_rel(n+1/2)) dt / 2
+   so that ke + erotate + pe + (dissipated) stays constant.
+   Contacts present when a run starts (the force evaluation of setup) are
+   taken as given: they book nothing.                                        */
+
+#include "pair_jkr_dt.h"
+
+#include "fix_jkr_dt_contacts.h"
+#include "jkr_dt_normal.h"
+
+#include "atom.h"
+#include "comm.h"
+#include "domain.h"
+#include "error.h"
+#include "memory.h"
+#include "modify.h"
+#include "neigh_list.h"
+#include "neighbor.h"
+#include "update.h"
+
+#include <algorithm>
+#include <cmath>
+
+using namespace LAMMPS_NS;
+using Contacts = FixJKRDTContacts;
+
+const char *const PairJKRDT::FIX_ID = "JKR_DT_CONTACTS";
+
+/* ---------------------------------------------------------------------- */
+
+PairJKRDT::PairJKRDT(LAMMPS *lmp) :
+    Pair(lmp), fix_contacts(nullptr), visited(nullptr), nmax_visited(0), nstride(0)
+{
+  single_enable = 0;
+  restartinfo = 1;
+  writedata = 1;
+  no_virial_fdotr_compute = 1;    // forces go to owned atoms only
+  nextra = NPVECTOR;
+  pvector = new double[nextra];
+  std::fill(pvector, pvector + nextra, 0.0);
+}
+
+/* ---------------------------------------------------------------------- */
+
+PairJKRDT::~PairJKRDT()
+{
+  delete[] pvector;
+  memory->destroy(visited);
+  if (allocated) {
+    memory->destroy(setflag);
+    memory->destroy(cutsq);
+  }
+  if (fix_contacts && modify->get_fix_by_id(FIX_ID)) modify->delete_fix(FIX_ID);
+}
+
+/* ---------------------------------------------------------------------- */
+
+void PairJKRDT::init_style()
+{
+  if (!atom->radius_flag || !atom->rmass_flag || !atom->omega_flag)
+    error->all(FLERR,
+               "pair jkr/dt requires atom_style sphere (per-atom radius, rmass and omega)");
+  if (!comm->ghost_velocity)
+    error->all(FLERR,
+               "pair jkr/dt requires velocities of ghost atoms: add 'comm_modify vel yes'");
+  if (!atom->tag_enable)
+    error->all(FLERR, "pair jkr/dt requires atom IDs: contacts are keyed by the IDs of the pair");
+
+  find_max_radii();
+  double cutmax = 0.0;
+  for (int i = 1; i <= atom->ntypes; i++)
+    for (int j = i; j <= atom->ntypes; j++) {
+      param[i * nstride + j] = resolve(i, j);
+      cutmax = std::max(cutmax, par(i, j).cut);
+    }
+  check_periodic_images(cutmax);
+
+  neighbor->add_request(this, NeighConst::REQ_NEWTON_OFF);
+
+  auto *fix = modify->get_fix_by_id(FIX_ID);
+  if (fix) {
+    fix_contacts = dynamic_cast<Contacts *>(fix);
+    if (!fix_contacts) error->all(FLERR, "fix ID {} is reserved for pair jkr/dt", FIX_ID);
+    fix_contacts->set_layout(layout_mask());
+  } else {
+    fix_contacts = dynamic_cast<Contacts *>(
+        modify->add_fix(fmt::format("{} all jkr/dt/contacts {}", FIX_ID, layout_mask())));
+  }
+}
+
+/* ----------------------------------------------------------------------
+   per-contact fields that some type pair needs
+------------------------------------------------------------------------- */
+
+int PairJKRDT::layout_mask() const
+{
+  int mask = 0;
+  for (int i = 1; i <= atom->ntypes; i++)
+    for (int j = i; j <= atom->ntypes; j++)
+      if (par(i, j).damp_coef > 0.0) mask |= 1 << Contacts::DAMPING_FORCE;
+  return mask;
+}
+
+/* ----------------------------------------------------------------------
+   largest radius of each type, for the neighbor cutoff; radii must be > 0
+------------------------------------------------------------------------- */
+
+void PairJKRDT::find_max_radii()
+{
+  std::vector<double> mine(nstride, 0.0);
+  int bad = 0;
+  for (int i = 0; i < atom->nlocal; i++) {
+    const double r = atom->radius[i];
+    if (!(r > 0.0) || !std::isfinite(r)) bad = 1;
+    else mine[atom->type[i]] = std::max(mine[atom->type[i]], r);
+  }
+  int anybad = 0;
+  MPI_Allreduce(&bad, &anybad, 1, MPI_INT, MPI_MAX, world);
+  if (anybad)
+    error->all(FLERR, "pair jkr/dt: every particle needs a finite radius > 0 (set diameter)");
+  MPI_Allreduce(mine.data(), maxrad.data(), nstride, MPI_DOUBLE, MPI_MAX, world);
+}
+
+/* ----------------------------------------------------------------------
+   contact state is looked up by partner ID, so a particle must never see
+   two periodic images of one partner inside its neighbor list
+------------------------------------------------------------------------- */
+
+void PairJKRDT::check_periodic_images(double cutmax)
+{
+  const double need = 2.0 * (cutmax + neighbor->skin);
+  const char *axis = "xyz";
+  for (int d = 0; d < domain->dimension; d++)
+    if (domain->periodicity[d] && domain->prd[d] < need)
+      error->all(FLERR,
+                 "pair jkr/dt: periodic box length {} along {} is shorter than 2 (cutoff + skin) "
+                 "= {}; a particle could see two images of one contact partner. Enlarge the box "
+                 "or make that direction non-periodic",
+                 domain->prd[d], axis[d], need);
+}
+
+/* ----------------------------------------------------------------------
+   half of a contact's dissipation goes to each of its owned atoms
+------------------------------------------------------------------------- */
+
+void PairJKRDT::book(int channel, double energy, int p, int q, int nlocal)
+{
+  if (p < nlocal) fix_contacts->ledger[p][channel] += 0.5 * energy;
+  if (q < nlocal) fix_contacts->ledger[q][channel] += 0.5 * energy;
+}
+
+/* ---------------------------------------------------------------------- */
+
+void PairJKRDT::compute(int eflag, int vflag)
+{
+  ev_init(eflag, vflag);
+
+  double **x = atom->x;
+  double **v = atom->v;
+  double **f = atom->f;
+  const double *radius = atom->radius;
+  const tagint *tag = atom->tag;
+  const int *type = atom->type;
+  const int nlocal = atom->nlocal;
+  const bool setup = update->setupflag;
+  const double dt = update->dt;
+
+  Contacts &C = *fix_contacts;
+  const int off_fd = C.has_field(Contacts::DAMPING_FORCE) ? C.offset(Contacts::DAMPING_FORCE) : -1;
+  const double u_break = JKRDT::potential_ratio_at_break();
+
+  if (nlocal > nmax_visited) {
+    memory->destroy(visited);
+    nmax_visited = atom->nmax;
+    memory->create(visited, nmax_visited, "jkr/dt:visited");
+  }
+  std::fill(visited, visited + nlocal, 0);
+
+  double upot = 0.0;
+  const int inum = list->inum;
+  const int *ilist = list->ilist;
+  const int *numneigh = list->numneigh;
+  int **firstneigh = list->firstneigh;
+
+  for (int ii = 0; ii < inum; ii++) {
+    const int i = ilist[ii];
+    const int *jlist = firstneigh[i];
+    for (int jj = 0; jj < numneigh[i]; jj++) {
+      const int j = jlist[jj] & NEIGHMASK;
+
+      // canonical orientation: p has the smaller ID
+      int p = i, q = j;
+      if (tag[q] < tag[p]) std::swap(p, q);
+      const bool p_own = p < nlocal, q_own = q < nlocal;
+      const int kp = p_own ? C.find(p, tag[q]) : -1;
+      const int kq = q_own ? C.find(q, tag[p]) : -1;
+      if (p_own && q_own && ((kp < 0) != (kq < 0)))
+        error->one(FLERR, "pair jkr/dt: contact {}-{} is stored with only one of its atoms",
+                   tag[p], tag[q]);
+      const bool bonded = (kp >= 0) || (kq >= 0);
+
+      const double delx = x[p][0] - x[q][0];
+      const double dely = x[p][1] - x[q][1];
+      const double delz = x[p][2] - x[q][2];
+      const double rsq = delx * delx + dely * dely + delz * delz;
+      const double radsum = radius[p] + radius[q];
+      if (!bonded && rsq > radsum * radsum) continue;
+
+      const double r = std::sqrt(rsq);
+      const double delta = radsum - r;    // eq. (3)
+      if (!std::isfinite(delta) || r == 0.0)
+        error->one(FLERR,
+                   "pair jkr/dt: atoms {} and {} are at distance {}; the run has blown up "
+                   "(reduce the timestep)",
+                   tag[p], tag[q], r);
+
+      const Param &P = par(type[p], type[q]);
+      const JKRDT::NormalScales S =
+          JKRDT::normal_scales(radius[p], radius[q], P.gamma, P.a0_coef);
+
+      double *state_p = (p_own && C.dnum) ? C.contact_values(p, kp) : nullptr;
+      double *state_q = (q_own && C.dnum) ? C.contact_values(q, kq) : nullptr;
+      const double rinv = 1.0 / r;
+      const double vn = (off_fd >= 0) ? ((v[p][0] - v[q][0]) * delx + (v[p][1] - v[q][1]) * dely +
+                                         (v[p][2] - v[q][2]) * delz) * rinv
+                                      : 0.0;
+
+      if (bonded && delta < -S.delta_c) {
+        // separation (section 2.1): U_n jumps from U_n(-delta_c) to 0
+        if (!setup) {
+          book(Contacts::FORM_BREAK, u_break * S.F_c * S.delta_c, p, q, nlocal);
+          if (P.damp_coef > 0.0) {
+            const double fd_prev = state_p ? state_p[off_fd] : state_q[off_fd];
+            book(Contacts::DAMPING, 0.5 * dt * fd_prev * vn, p, q, nlocal);
+          }
+        }
+        if (p_own) C.remove(p, kp);
+        if (q_own) C.remove(q, kq);
+        continue;
+      }
+
+      const bool formed = !bonded;    // delta >= 0 here: contact formation (section 2.1)
+      if (formed) {
+        if (p_own) state_p = C.add(p, tag[q]);
+        if (q_own) state_q = C.add(q, tag[p]);
+      }
+
+      const double y = JKRDT::contact_sqrt_radius(delta / S.delta0);    // eq. (4)
+      double fmag = S.F_c * JKRDT::normal_force_ratio(y);               // eq. (5)
+      double u_n = 0.0;
+      if (eflag || (formed && !setup))
+        u_n = S.F_c * S.delta_c * JKRDT::normal_potential_ratio(y);    // eq. (6)
+      if (formed && !setup) book(Contacts::FORM_BREAK, -u_n, p, q, nlocal);
+
+      if (P.damp_coef > 0.0) {
+        // eq. (A.5); a run's first evaluation reuses the stored F_D, so that a
+        // continued run equals an uninterrupted one
+        double *state = state_p ? state_p : state_q;
+        const double fd_prev = formed ? 0.0 : state[off_fd];
+        const double fd = (setup && !formed) ? fd_prev : P.damp_coef * y * y * S.a0 * vn;
+        if (!setup) book(Contacts::DAMPING, 0.5 * dt * (fd_prev + fd) * vn, p, q, nlocal);
+        if (state_p) state_p[off_fd] = fd;
+        if (state_q) state_q[off_fd] = fd;
+        fmag -= fd;
+      }
+
+      const double fpair = fmag * rinv;
+      if (p_own) {
+        f[p][0] += delx * fpair;
+        f[p][1] += dely * fpair;
+        f[p][2] += delz * fpair;
+        visited[p]++;
+      }
+      if (q_own) {
+        f[q][0] -= delx * fpair;
+        f[q][1] -= dely * fpair;
+        f[q][2] -= delz * fpair;
+        visited[q]++;
+      }
+      if (eflag) upot += 0.5 * ((p_own ? 1.0 : 0.0) + (q_own ? 1.0 : 0.0)) * u_n;
+      if (evflag) ev_tally(p, q, nlocal, 0, u_n, 0.0, fpair, delx, dely, delz);
+    }
+  }
+
+  for (int i = 0; i < nlocal; i++)
+    if (visited[i] != C.npartner[i]) report_unvisited_contact();
+
+  if (eflag_global) fill_pvector(upot);
+}
+
+/* ----------------------------------------------------------------------
+   a stored contact that the neighbor loop did not see: name it and stop
+------------------------------------------------------------------------- */
+
+void PairJKRDT::report_unvisited_contact()
+{
+  const int nlocal = atom->nlocal;
+  const tagint *tag = atom->tag;
+  std::vector<std::vector<tagint>> seen(nlocal);
+  for (int ii = 0; ii < list->inum; ii++) {
+    const int i = list->ilist[ii];
+    for (int jj = 0; jj < list->numneigh[i]; jj++) {
+      const int j = list->firstneigh[i][jj] & NEIGHMASK;
+      if (i < nlocal) seen[i].push_back(tag[j]);
+      if (j < nlocal) seen[j].push_back(tag[i]);
+    }
+  }
+  for (int i = 0; i < nlocal; i++)
+    for (int k = 0; k < fix_contacts->npartner[i]; k++) {
+      const tagint t = fix_contacts->partner[i][k];
+      if (std::find(seen[i].begin(), seen[i].end(), t) == seen[i].end())
+        error->one(FLERR,
+                   "pair jkr/dt: the contact between atoms {} and {} is no longer in the neighbor "
+                   "list, so it can be neither kept nor broken. Either atom {} was deleted, or "
+                   "atoms moved farther than half the skin between reneighborings: use "
+                   "'neigh_modify every 1 delay 0 check yes'",
+                   tag[i], t, t);
+    }
+  error->one(FLERR, "pair jkr/dt: contact bookkeeping is inconsistent on this rank");
+}
+
+/* ----------------------------------------------------------------------
+   this rank's share of the 10 values of compute pair jkr/dt; compute pair
+   sums them over ranks
+------------------------------------------------------------------------- */
+
+void PairJKRDT::fill_pvector(double upot)
+{
+  std::fill(pvector, pvector + NPVECTOR, 0.0);
+  pvector[0] = upot;    // U_n; slots 1-3 (U_s, U_r, U_t) come with the tangential channels
+  const auto &C = *fix_contacts;
+  double contacts = 0.0;
+  for (int i = 0; i < atom->nlocal; i++) {
+    for (int l = 0; l < Contacts::NLEDGER; l++) pvector[4 + l] += C.ledger[i][l];
+    contacts += 0.5 * C.npartner[i];
+  }
+  pvector[9] = contacts;
+}
+
+/* ----------------------------------------------------------------------
+   quantities of the bonded contact between local atom i and atom j
+------------------------------------------------------------------------- */
+
+bool PairJKRDT::bonded_contact(int i, int j, ContactView &view) const
+{
+  const tagint *tag = atom->tag;
+  if (fix_contacts->find(i, tag[j]) < 0) return false;
+  int p = i, q = j;
+  if (tag[q] < tag[p]) std::swap(p, q);
+  double **x = atom->x;
+  const double dx = x[p][0] - x[q][0], dy = x[p][1] - x[q][1], dz = x[p][2] - x[q][2];
+  const double r = std::sqrt(dx * dx + dy * dy + dz * dz);
+  const Param &P = par(atom->type[p], atom->type[q]);
+  const auto S = JKRDT::normal_scales(atom->radius[p], atom->radius[q], P.gamma, P.a0_coef);
+  view.id1 = tag[p];
+  view.id2 = tag[q];
+  view.delta = atom->radius[p] + atom->radius[q] - r;
+  const double y = JKRDT::contact_sqrt_radius(view.delta / S.delta0);
+  view.a = y * y * S.a0;
+  view.force = S.F_c * JKRDT::normal_force_ratio(y);
+  if (P.damp_coef > 0.0) {
+    const auto &C = *fix_contacts;
+    view.force -= C.values[i][C.find(i, tag[j]) * C.dnum + C.offset(Contacts::DAMPING_FORCE)];
+  }
+  return true;
+}
+
+/* ---------------------------------------------------------------------- */
+
+double PairJKRDT::memory_usage()
+{
+  return Pair::memory_usage() + nmax_visited * sizeof(int) +
+      (input.size() * sizeof(Input) + param.size() * sizeof(Param));
+}

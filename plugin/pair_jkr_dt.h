@@ -1,0 +1,95 @@
+/* jkr/dt: pair style for the contact model of Dominik & Tielens made
+   energy-conserving by Wada et al. (2007).
+
+   This class is the LAMMPS glue: coefficients and their mixing
+   (pair_jkr_dt_coeff.cpp), the neighbor-list loop, contact formation and
+   breaking, energy and dissipation bookkeeping (pair_jkr_dt.cpp). The
+   contact physics lives in jkr_dt_normal.h; the contact state in
+   FixJKRDTContacts.                                                        */
+
+#ifndef JKR_DT_PAIR_H
+#define JKR_DT_PAIR_H
+
+#include "pair.h"
+
+#include <vector>
+
+namespace LAMMPS_NS {
+
+class FixJKRDTContacts;
+
+class PairJKRDT : public Pair {
+ public:
+  // what pair_coeff gave for one type pair; NaN or -1 = not given
+  struct Input {
+    double gamma, E, nu, G, xi_crit, tvis;
+    int sliding, rolling, twisting;
+  };
+
+  // the parameters of one type pair after defaults and mixing
+  struct Param {
+    double gamma;       // surface energy
+    double Estar;       // reduced Young's modulus, eq. (2)
+    double Gstar;       // reduced shear modulus, eq. (13)
+    double nu;          // Poisson ratio in the damping of eq. (A.5)
+    double xi_crit;     // critical rolling displacement (NaN if rolling is off)
+    double tvis;        // viscoelastic time scale of eq. (A.5)
+    double a0_coef;     // (9 pi gamma / E*)^(1/3): a0 = a0_coef R^(2/3)
+    double damp_coef;   // 2 tvis E* / nu^2: F_D = damp_coef a v_rel
+    double cut;         // reach of a stretched contact between the largest radii
+    int sliding, rolling, twisting;
+  };
+
+  // one bonded contact, as the local compute reports it
+  struct ContactView {
+    tagint id1, id2;    // atom IDs, id1 < id2
+    double delta;       // compression length, eq. (3)
+    double a;           // contact radius, eq. (4)
+    double force;       // normal force on atom id1 along x1 - x2 (elastic + damping)
+  };
+
+  static constexpr int NPVECTOR = 10;
+  static const char *const FIX_ID;
+
+  PairJKRDT(class LAMMPS *);
+  ~PairJKRDT() override;
+
+  void compute(int, int) override;
+  void settings(int, char **) override;
+  void coeff(int, char **) override;
+  void init_style() override;
+  double init_one(int, int) override;
+  void write_restart(FILE *) override;
+  void read_restart(FILE *) override;
+  void write_data_all(FILE *) override;
+  double memory_usage() override;
+
+  bool bonded_contact(int i, int j, ContactView &view) const;
+  FixJKRDTContacts *contacts() const { return fix_contacts; }
+
+ protected:
+  std::vector<Input> input;    // (ntypes+1)^2, row-major
+  std::vector<Param> param;
+  std::vector<double> maxrad;  // largest radius of each type
+  FixJKRDTContacts *fix_contacts;
+  int *visited;                // bonded contacts of each local atom seen this step
+  int nmax_visited;
+
+  int nstride;                 // ntypes + 1
+  Input &in(int i, int j) { return input[i * nstride + j]; }
+  const Input &in(int i, int j) const { return input[i * nstride + j]; }
+  const Param &par(int i, int j) const { return param[i * nstride + j]; }
+
+  void allocate();
+  Param resolve(int i, int j) const;
+  int layout_mask() const;
+  void find_max_radii();
+  void check_periodic_images(double cutmax);
+  void book(int channel, double energy, int p, int q, int nlocal);
+  void report_unvisited_contact();
+  void fill_pvector(double upot);
+};
+
+}    // namespace LAMMPS_NS
+
+#endif

@@ -1,0 +1,274 @@
+/* jkr/dt: coefficients, defaults and mixing of unlike types.
+
+   pair_coeff I J keyword value ...
+     gamma <surface energy>   E <Young's modulus>   nu <Poisson ratio>
+     G <shear modulus>        xi_crit <length>       tvis <time>
+     sliding on|off   rolling on|off   twisting on|off   frictionless
+
+   A type's own line (I = J) gives its material: gamma, E and nu are required,
+   G defaults to E / (2 (1 + nu)). A line for unlike types (I != J) may set any
+   keyword; what it leaves out is mixed from the two types' own lines:
+     E*, G*   eqs. (2) and (13) from each type's E, nu, G
+     gamma    geometric mean sqrt(gamma_I gamma_J)   (work of adhesion 2 sqrt(gamma_I gamma_J))
+     nu       (in the damping of eq. A.5) arithmetic mean
+     xi_crit, tvis  arithmetic mean
+     channels on only where both types have them on
+   E, nu and G given on an unlike line are taken as the material of both
+   particles of that pair.                                                   */
+
+#include "pair_jkr_dt.h"
+
+#include "jkr_dt_normal.h"
+
+#include "atom.h"
+#include "comm.h"
+#include "error.h"
+#include "memory.h"
+#include "utils.h"
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+using namespace LAMMPS_NS;
+
+static constexpr double UNSET = std::numeric_limits<double>::quiet_NaN();
+static const PairJKRDT::Input NOTHING_GIVEN = {UNSET, UNSET, UNSET, UNSET, UNSET, UNSET, -1, -1, -1};
+
+static bool given(double x) { return !std::isnan(x); }
+
+/* ---------------------------------------------------------------------- */
+
+void PairJKRDT::settings(int narg, char **arg)
+{
+  if (narg > 0)
+    error->all(FLERR,
+               "pair_style jkr/dt takes no arguments (got '{}'); material parameters go in "
+               "pair_coeff",
+               arg[0]);
+}
+
+/* ---------------------------------------------------------------------- */
+
+void PairJKRDT::allocate()
+{
+  allocated = 1;
+  const int n = atom->ntypes;
+  nstride = n + 1;
+  memory->create(setflag, n + 1, n + 1, "pair:setflag");
+  memory->create(cutsq, n + 1, n + 1, "pair:cutsq");
+  for (int i = 0; i <= n; i++)
+    for (int j = 0; j <= n; j++) setflag[i][j] = 0;
+  input.assign(nstride * nstride, NOTHING_GIVEN);
+  param.assign(nstride * nstride, Param());
+  maxrad.assign(nstride, 0.0);
+}
+
+/* ---------------------------------------------------------------------- */
+
+void PairJKRDT::coeff(int narg, char **arg)
+{
+  if (narg < 2) error->all(FLERR, "pair_coeff for jkr/dt: expected 'pair_coeff I J keyword value ...'");
+  if (!allocated) allocate();
+
+  int ilo, ihi, jlo, jhi;
+  utils::bounds(FLERR, arg[0], 1, atom->ntypes, ilo, ihi, error);
+  utils::bounds(FLERR, arg[1], 1, atom->ntypes, jlo, jhi, error);
+
+  Input g = NOTHING_GIVEN;
+  int iarg = 2;
+  auto value = [&](const std::string &key) -> const char * {
+    if (iarg + 1 >= narg)
+      error->all(FLERR, "pair_coeff for jkr/dt: keyword '{}' needs a value", key);
+    return arg[iarg + 1];
+  };
+  auto positive = [&](const std::string &key) {
+    const double x = utils::numeric(FLERR, value(key), false, lmp);
+    if (!(x > 0.0)) error->all(FLERR, "pair_coeff for jkr/dt: {} must be > 0 (got {})", key, x);
+    return x;
+  };
+
+  while (iarg < narg) {
+    const std::string key = arg[iarg];
+    if (key == "gamma") {
+      g.gamma = positive(key);
+    } else if (key == "E") {
+      g.E = positive(key);
+    } else if (key == "G") {
+      g.G = positive(key);
+    } else if (key == "xi_crit") {
+      g.xi_crit = positive(key);
+    } else if (key == "nu") {
+      g.nu = utils::numeric(FLERR, value(key), false, lmp);
+      if (!(g.nu > -1.0 && g.nu < 0.5))
+        error->all(FLERR, "pair_coeff for jkr/dt: nu must lie in (-1, 0.5) (got {})", g.nu);
+    } else if (key == "tvis") {
+      g.tvis = utils::numeric(FLERR, value(key), false, lmp);
+      if (!(g.tvis >= 0.0))
+        error->all(FLERR, "pair_coeff for jkr/dt: tvis must be >= 0; 0 means no damping (got {})",
+                   g.tvis);
+    } else if (key == "sliding") {
+      g.sliding = utils::logical(FLERR, value(key), false, lmp);
+    } else if (key == "rolling") {
+      g.rolling = utils::logical(FLERR, value(key), false, lmp);
+    } else if (key == "twisting") {
+      g.twisting = utils::logical(FLERR, value(key), false, lmp);
+    } else if (key == "frictionless") {
+      g.sliding = g.rolling = g.twisting = 0;
+      iarg += 1;
+      continue;
+    } else {
+      error->all(FLERR,
+                 "pair_coeff for jkr/dt: unknown keyword '{}'; allowed: gamma E nu G xi_crit "
+                 "tvis sliding rolling twisting frictionless",
+                 key);
+    }
+    iarg += 2;
+  }
+
+  if (given(g.E) != given(g.nu))
+    error->all(FLERR, "pair_coeff for jkr/dt: E and nu go together; give both or neither");
+  if (given(g.G) && !given(g.E))
+    error->all(FLERR, "pair_coeff for jkr/dt: G needs E and nu on the same line");
+
+  int count = 0;
+  for (int i = ilo; i <= ihi; i++)
+    for (int j = std::max(jlo, i); j <= jhi; j++) {
+      if (i == j && !(given(g.gamma) && given(g.E)))
+        error->all(FLERR,
+                   "pair_coeff {} {} for jkr/dt: a type's own line must give its material: "
+                   "gamma, E and nu",
+                   i, j);
+      in(i, j) = g;
+      setflag[i][j] = 1;
+      count++;
+    }
+  if (count == 0) error->all(FLERR, "pair_coeff for jkr/dt: no type pair matched {} {}", arg[0], arg[1]);
+}
+
+/* ----------------------------------------------------------------------
+   defaults and mixing for type pair (i,j); errors name the missing piece
+------------------------------------------------------------------------- */
+
+PairJKRDT::Param PairJKRDT::resolve(int i, int j) const
+{
+  const Input &ij = in(i, j), &ii = in(i, i), &jj = in(j, j);
+  const bool own = setflag[i][j] != 0;
+
+  // material of the two sides: the pair's own line if it gives one, else each type's
+  const Input &m1 = (own && given(ij.E)) ? ij : ii;
+  const Input &m2 = (own && given(ij.E)) ? ij : jj;
+  auto shear = [](const Input &m) { return given(m.G) ? m.G : m.E / (2.0 * (1.0 + m.nu)); };
+
+  Param P;
+  P.Estar = 1.0 / ((1.0 - m1.nu * m1.nu) / m1.E + (1.0 - m2.nu * m2.nu) / m2.E);    // eq. (2)
+  P.Gstar = 1.0 / ((2.0 - m1.nu) / shear(m1) + (2.0 - m2.nu) / shear(m2));          // eq. (13)
+  P.nu = 0.5 * (m1.nu + m2.nu);
+
+  auto mean = [](double a, double b) { return 0.5 * (a + b); };
+  auto zero_if_unset = [](double x) { return given(x) ? x : 0.0; };
+  P.gamma = (own && given(ij.gamma)) ? ij.gamma : std::sqrt(ii.gamma * jj.gamma);
+  P.xi_crit = (own && given(ij.xi_crit)) ? ij.xi_crit : mean(ii.xi_crit, jj.xi_crit);
+  P.tvis = (own && given(ij.tvis)) ? ij.tvis : mean(zero_if_unset(ii.tvis), zero_if_unset(jj.tvis));
+
+  auto channel = [&](int own_flag, int a, int b) {
+    if (own && own_flag >= 0) return own_flag;
+    return (a != 0 && b != 0) ? 1 : 0;    // unset (-1) counts as on
+  };
+  P.sliding = channel(ij.sliding, ii.sliding, jj.sliding);
+  P.rolling = channel(ij.rolling, ii.rolling, jj.rolling);
+  P.twisting = channel(ij.twisting, ii.twisting, jj.twisting);
+
+  if (P.rolling && std::isnan(P.xi_crit))
+    error->all(FLERR,
+               "pair jkr/dt: rolling is on for types {} {} but xi_crit is not set; give "
+               "'xi_crit <length>' (the papers use 2, 8 or 30 Angstrom) or 'rolling off' or "
+               "'frictionless'",
+               i, j);
+  if (P.tvis > 0.0 && P.nu == 0.0)
+    error->all(FLERR,
+               "pair jkr/dt: types {} {} have tvis > 0 but nu = 0; the damping of eq. (A.5) "
+               "divides by nu^2",
+               i, j);
+
+  P.a0_coef = JKRDT::a0_coefficient(P.gamma, P.Estar);
+  P.damp_coef = (P.tvis > 0.0) ? JKRDT::damping_coefficient(P.tvis, P.Estar, P.nu) : 0.0;
+
+  // a stretched contact reaches r1 + r2 + delta_c; delta_c grows with R as R^(1/3)
+  const double r1 = maxrad[i], r2 = maxrad[j];
+  P.cut = 0.0;
+  if (r1 > 0.0 && r2 > 0.0) P.cut = r1 + r2 + JKRDT::normal_scales(r1, r2, P.gamma, P.a0_coef).delta_c;
+  return P;
+}
+
+/* ---------------------------------------------------------------------- */
+
+double PairJKRDT::init_one(int i, int j)
+{
+  // parameters were resolved in init_style(); keep them symmetric
+  param[j * nstride + i] = param[i * nstride + j];
+  return par(i, j).cut;
+}
+
+/* ----------------------------------------------------------------------
+   restart and data files carry what the user gave, not the mixed values,
+   so a continued run mixes exactly as the first one did
+------------------------------------------------------------------------- */
+
+static void write_input(FILE *fp, const PairJKRDT::Input &g)
+{
+  const double d[6] = {g.gamma, g.E, g.nu, g.G, g.xi_crit, g.tvis};
+  const int k[3] = {g.sliding, g.rolling, g.twisting};
+  fwrite(d, sizeof(double), 6, fp);
+  fwrite(k, sizeof(int), 3, fp);
+}
+
+void PairJKRDT::write_restart(FILE *fp)
+{
+  for (int i = 1; i <= atom->ntypes; i++)
+    for (int j = i; j <= atom->ntypes; j++) {
+      fwrite(&setflag[i][j], sizeof(int), 1, fp);
+      if (setflag[i][j]) write_input(fp, in(i, j));
+    }
+}
+
+void PairJKRDT::read_restart(FILE *fp)
+{
+  allocate();
+  const int me = comm->me;
+  for (int i = 1; i <= atom->ntypes; i++)
+    for (int j = i; j <= atom->ntypes; j++) {
+      if (me == 0) utils::sfread(FLERR, &setflag[i][j], sizeof(int), 1, fp, nullptr, error);
+      MPI_Bcast(&setflag[i][j], 1, MPI_INT, 0, world);
+      if (!setflag[i][j]) continue;
+      double d[6];
+      int k[3];
+      if (me == 0) {
+        utils::sfread(FLERR, d, sizeof(double), 6, fp, nullptr, error);
+        utils::sfread(FLERR, k, sizeof(int), 3, fp, nullptr, error);
+      }
+      MPI_Bcast(d, 6, MPI_DOUBLE, 0, world);
+      MPI_Bcast(k, 3, MPI_INT, 0, world);
+      in(i, j) = {d[0], d[1], d[2], d[3], d[4], d[5], k[0], k[1], k[2]};
+    }
+}
+
+void PairJKRDT::write_data_all(FILE *fp)
+{
+  for (int i = 1; i <= atom->ntypes; i++)
+    for (int j = i; j <= atom->ntypes; j++) {
+      if (!setflag[i][j]) continue;
+      const Input &g = in(i, j);
+      std::string line = fmt::format("{} {}", i, j);
+      const std::pair<const char *, double> reals[] = {{"gamma", g.gamma}, {"E", g.E},
+                                                       {"nu", g.nu},       {"G", g.G},
+                                                       {"xi_crit", g.xi_crit}, {"tvis", g.tvis}};
+      for (const auto &kv : reals)
+        if (given(kv.second)) line += fmt::format(" {} {:.17g}", kv.first, kv.second);
+      const std::pair<const char *, int> flags[] = {
+          {"sliding", g.sliding}, {"rolling", g.rolling}, {"twisting", g.twisting}};
+      for (const auto &kv : flags)
+        if (kv.second >= 0) line += fmt::format(" {} {}", kv.first, kv.second ? "on" : "off");
+      fmt::print(fp, "{}\n", line);
+    }
+}
