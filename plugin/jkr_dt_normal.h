@@ -125,6 +125,25 @@ inline double potential_ratio_at_touch()
 inline double potential_ratio_at_break() { return normal_potential_ratio(y_break()); }
 
 /* ---------------------------------------------------------------------
+   energy lost when a contact forms or breaks (section 2.1)
+
+   U_n jumps at contact (from 0 to U_n(0) ~ -0.847 F_c delta_c) and at
+   separation (from U_n(-delta_c) ~ 0.089 F_c delta_c to 0). A time step
+   meets the event late, between two steps: the potential jumps from
+   u_before to u_after there, and the force f on either side of the jump
+   enters (formation) or leaves (breaking) the velocity-Verlet update one
+   half-kick early, which moves dt/2 f v_n into the kinetic energy. The loss
+   booked is both, so that ke + pe + dissipated stays continuous across the
+   event; it differs from the continuum jump by O(F_c v_n dt).
+   v_n is the normal relative velocity, > 0 when separating; f > 0 repulsive.
+------------------------------------------------------------------------ */
+
+inline double event_loss(double u_before, double u_after, double f, double vn, double dt)
+{
+  return u_before - u_after - 0.5 * dt * f * vn;
+}
+
+/* ---------------------------------------------------------------------
    viscoelastic damping, eq. (A.5): F_D = 2 T_vis E* / nu^2 * a * v_rel
    damping_coefficient() returns 2 T_vis E* / nu^2; multiply by a v_rel.
 ------------------------------------------------------------------------ */

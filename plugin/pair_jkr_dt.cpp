@@ -12,8 +12,8 @@
    Energy. pe holds the contact potentials U_n, eq. (6). The energy that
    leaves the mechanical budget is booked per channel in the contact fix's
    per-atom ledger, half to each atom of the contact:
-     formation  -U_n(delta) at the step the contact forms (the jump of pe)
-     breaking   U_n(-delta_c) when delta drops below -delta_c
+     formation, breaking  the jump of U_n (section 2.1) as the integrator
+                meets it: see event_loss() in jkr_dt_normal.h
      damping    the work of F_D of eq. (A.5) across the two half-kicks of
                 velocity Verlet that apply it: F_D(n) (v_rel(n-1/2) + v_rel(n+1/2)) dt / 2
    so that ke + erotate + pe + (dissipated) stays constant.
@@ -184,7 +184,6 @@ void PairJKRDT::compute(int eflag, int vflag)
 
   Contacts &C = *fix_contacts;
   const int off_fd = C.has_field(Contacts::DAMPING_FORCE) ? C.offset(Contacts::DAMPING_FORCE) : -1;
-  const double u_break = JKRDT::potential_ratio_at_break();
 
   if (nlocal > nmax_visited) {
     memory->destroy(visited);
@@ -238,14 +237,14 @@ void PairJKRDT::compute(int eflag, int vflag)
       double *state_p = (p_own && C.dnum) ? C.contact_values(p, kp) : nullptr;
       double *state_q = (q_own && C.dnum) ? C.contact_values(q, kq) : nullptr;
       const double rinv = 1.0 / r;
-      const double vn = (off_fd >= 0) ? ((v[p][0] - v[q][0]) * delx + (v[p][1] - v[q][1]) * dely +
-                                         (v[p][2] - v[q][2]) * delz) * rinv
-                                      : 0.0;
+      // normal relative velocity at the half step, > 0 when separating
+      const double vn = ((v[p][0] - v[q][0]) * delx + (v[p][1] - v[q][1]) * dely +
+                         (v[p][2] - v[q][2]) * delz) * rinv;
 
       if (bonded && delta < -S.delta_c) {
-        // separation (section 2.1): U_n jumps from U_n(-delta_c) to 0
+        // separation (section 2.1): U_n drops to 0 from its value at the last step
         if (!setup) {
-          book(Contacts::FORM_BREAK, u_break * S.F_c * S.delta_c, p, q, nlocal);
+          book(Contacts::FORM_BREAK, breaking_loss(delta, vn, dt, S), p, q, nlocal);
           if (P.damp_coef > 0.0) {
             const double fd_prev = state_p ? state_p[off_fd] : state_q[off_fd];
             book(Contacts::DAMPING, 0.5 * dt * fd_prev * vn, p, q, nlocal);
@@ -267,7 +266,8 @@ void PairJKRDT::compute(int eflag, int vflag)
       double u_n = 0.0;
       if (eflag || (formed && !setup))
         u_n = S.F_c * S.delta_c * JKRDT::normal_potential_ratio(y);    // eq. (6)
-      if (formed && !setup) book(Contacts::FORM_BREAK, -u_n, p, q, nlocal);
+      if (formed && !setup)
+        book(Contacts::FORM_BREAK, JKRDT::event_loss(0.0, u_n, fmag, vn, dt), p, q, nlocal);
 
       if (P.damp_coef > 0.0) {
         // eq. (A.5); a run's first evaluation reuses the stored F_D, so that a
@@ -303,6 +303,21 @@ void PairJKRDT::compute(int eflag, int vflag)
     if (visited[i] != C.npartner[i]) report_unvisited_contact();
 
   if (eflag_global) fill_pvector(upot);
+}
+
+/* ----------------------------------------------------------------------
+   loss at separation: the contact was last evaluated one step earlier, at
+   delta_prev = delta + vn dt (straight-line relative motion over the step),
+   held no further than the break point -delta_c
+------------------------------------------------------------------------- */
+
+double PairJKRDT::breaking_loss(double delta, double vn, double dt, const JKRDT::NormalScales &S)
+{
+  const double delta_prev = std::max(delta + vn * dt, -S.delta_c);
+  const double y = JKRDT::contact_sqrt_radius(delta_prev / S.delta0);
+  const double u_prev = S.F_c * S.delta_c * JKRDT::normal_potential_ratio(y);
+  const double f_prev = S.F_c * JKRDT::normal_force_ratio(y);
+  return JKRDT::event_loss(u_prev, 0.0, f_prev, vn, dt);
 }
 
 /* ----------------------------------------------------------------------

@@ -12,6 +12,8 @@
 
 #include "pair.h"
 
+#include "jkr_dt_normal.h"
+
 #include <vector>
 
 namespace LAMMPS_NS {
@@ -86,6 +88,7 @@ class PairJKRDT : public Pair {
   void find_max_radii();
   void check_periodic_images(double cutmax);
   void book(int channel, double energy, int p, int q, int nlocal);
+  static double breaking_loss(double delta, double vn, double dt, const JKRDT::NormalScales &S);
   void report_unvisited_contact();
   void fill_pvector(double upot);
 };

@@ -1,0 +1,1 @@
+"""Collision outcome analysis: fragments, growth efficiency, compression, energy partition."""

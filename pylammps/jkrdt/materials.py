@@ -1,0 +1,123 @@
+"""Grain materials and the contact scales they imply.
+
+All quantities are SI. The presets are Table 2 of Wada et al. (2007) with the
+critical rolling displacements used in the two papers: 2 or 30 Angstrom in
+Wada et al. (2007), 8 Angstrom for ice in the 3D BPCA paper.
+
+Derived scales for two equal grains of radius r (Wada et al. 2007, sec. 2 and 4):
+
+=========  ============================================  ===========
+a0         (9 pi gamma R^2 / E*)^(1/3)                    eq. (1)
+delta0     a0^2 / (3 R)                                   below (4)
+delta_c    (9/16)^(1/3) delta0                            below (5)
+F_c        3 pi gamma R                                   below (5)
+v0, t_c    sqrt(F_c delta_c / m), delta_c / v0            eqs. (48)-(49)
+E_roll     12 pi^2 gamma R xi_crit                        eq. (44), (A.9)
+E_break    (4/45 + 4/5 6^(1/3)) F_c delta_c ~ 1.54 F_c delta_c   eq. (45), (A.7)
+=========  ============================================  ===========
+with R = r/2 and E* = E / (2 (1 - nu^2)).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+ANGSTROM = 1.0e-10
+
+
+@dataclasses.dataclass(frozen=True)
+class Material:
+    """A grain material. SI units: J/m^2, Pa, kg/m^3, m, s."""
+
+    name: str
+    gamma: float            # surface energy
+    E: float                # Young's modulus
+    nu: float               # Poisson ratio
+    density: float
+    xi_crit: float | None   # critical rolling displacement; None = rolling off
+    G: float | None = None  # shear modulus; None = E / (2 (1 + nu))
+    tvis: float = 0.0       # viscoelastic time scale of eq. (A.5); 0 = no damping
+
+    def __post_init__(self):
+        for field in ("gamma", "E", "density"):
+            if not getattr(self, field) > 0:
+                raise ValueError(f"Material {self.name!r}: {field} must be > 0")
+        if not -1.0 < self.nu < 0.5:
+            raise ValueError(f"Material {self.name!r}: nu must lie in (-1, 0.5)")
+        if self.xi_crit is not None and not self.xi_crit > 0:
+            raise ValueError(f"Material {self.name!r}: xi_crit must be > 0 or None")
+        if self.tvis < 0:
+            raise ValueError(f"Material {self.name!r}: tvis must be >= 0")
+
+    @property
+    def shear_modulus(self) -> float:
+        return self.G if self.G is not None else self.E / (2.0 * (1.0 + self.nu))
+
+    def pair_coeff(self, frictionless: bool = False) -> str:
+        """Keyword arguments of ``pair_coeff I J`` for this material, SI units."""
+        words = [f"gamma {self.gamma!r}", f"E {self.E!r}", f"nu {self.nu!r}"]
+        if self.G is not None:
+            words.append(f"G {self.G!r}")
+        if self.tvis > 0:
+            words.append(f"tvis {self.tvis!r}")
+        if frictionless:
+            words.append("frictionless")
+        elif self.xi_crit is None:
+            words.append("rolling off")
+        else:
+            words.append(f"xi_crit {self.xi_crit!r}")
+        return " ".join(words)
+
+
+ICE = Material("ice", gamma=0.100, E=7.0e9, nu=0.25, density=1000.0, xi_crit=8 * ANGSTROM)
+QUARTZ = Material("quartz", gamma=0.025, E=54.0e9, nu=0.17, density=2600.0, xi_crit=2 * ANGSTROM)
+PRESETS = {m.name: m for m in (ICE, QUARTZ)}
+
+
+def material(name: str, **overrides) -> Material:
+    """A preset by name ('ice', 'quartz'), with any field overridden."""
+    try:
+        base = PRESETS[name]
+    except KeyError:
+        raise ValueError(f"unknown material {name!r}; presets: {', '.join(PRESETS)}") from None
+    return dataclasses.replace(base, **overrides)
+
+
+@dataclasses.dataclass(frozen=True)
+class Scales:
+    """Contact scales of two equal grains of radius ``r`` (SI)."""
+
+    r: float
+    R: float
+    Estar: float
+    a0: float
+    delta0: float
+    delta_c: float
+    F_c: float
+    mass: float
+    v0: float
+    t_c: float
+    E_roll: float | None
+    E_break: float
+
+
+E_BREAK_RATIO = 4.0 / 45.0 + 0.8 * 6.0 ** (1.0 / 3.0)   # E_break / (F_c delta_c), eq. (A.7)
+
+
+def scales(mat: Material, r: float) -> Scales:
+    """Derived contact scales for two grains of radius ``r`` of ``mat``."""
+    if not r > 0:
+        raise ValueError("grain radius must be > 0")
+    R = r / 2.0
+    Estar = mat.E / (2.0 * (1.0 - mat.nu ** 2))
+    a0 = (9.0 * math.pi * mat.gamma * R ** 2 / Estar) ** (1.0 / 3.0)
+    delta0 = a0 ** 2 / (3.0 * R)
+    delta_c = (9.0 / 16.0) ** (1.0 / 3.0) * delta0
+    F_c = 3.0 * math.pi * mat.gamma * R
+    mass = 4.0 / 3.0 * math.pi * r ** 3 * mat.density
+    v0 = math.sqrt(F_c * delta_c / mass)
+    E_roll = None if mat.xi_crit is None else 12.0 * math.pi ** 2 * mat.gamma * R * mat.xi_crit
+    return Scales(r=r, R=R, Estar=Estar, a0=a0, delta0=delta0, delta_c=delta_c, F_c=F_c,
+                  mass=mass, v0=v0, t_c=delta_c / v0, E_roll=E_roll,
+                  E_break=E_BREAK_RATIO * F_c * delta_c)

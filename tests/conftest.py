@@ -1,0 +1,100 @@
+"""Shared scenes for the tests: real LAMMPS instances with pair jkr/dt."""
+
+import math
+
+import numpy as np
+import pytest
+
+from jkrdt.materials import ICE, scales
+from jkrdt.session import start_lammps
+
+R_GRAIN = 1.0e-7          # 0.1 micron grains, as in both papers
+ICE_SCALES = scales(ICE, R_GRAIN)
+
+
+def jkr_sqrt_radius(d):
+    """Reference for eq. (4), independent of the plugin: the largest real root
+    y = sqrt(a/a0) of 3 y^4 - 2 y - d = 0."""
+    roots = np.roots([3.0, 0.0, 0.0, -2.0, -d])
+    return max(r.real for r in roots if abs(r.imag) < 1e-9)
+
+
+def jkr_force(delta, s):
+    """Eq. (5) at compression ``delta`` for scales ``s``."""
+    y = jkr_sqrt_radius(delta / s.delta0)
+    return 4.0 * s.F_c * y ** 3 * (y ** 3 - 1.0)
+
+
+def jkr_potential(delta, s):
+    """Eq. (6) at compression ``delta`` for scales ``s``."""
+    x = jkr_sqrt_radius(delta / s.delta0) ** 2
+    return 4.0 * 6 ** (1 / 3) * s.F_c * s.delta_c * (0.8 * x ** 5 - 4 / 3 * x ** 3.5 + x ** 2 / 3)
+
+
+ENERGY_THERMO = "step ke c_erot pe c_p[1] c_p[5] c_p[6] c_p[7] c_p[8] c_p[9] c_p[10]"
+
+
+def two_grain_scene(lmp, separation, v_rel=0.0, material=ICE, coeff_extra="frictionless",
+                    dt_over_tc=0.01, newton="off", box=2.0e-6):
+    """Two ice grains on the x axis, ``separation`` apart (centre to centre),
+    approaching each other at ``v_rel``. Thermo carries the energy ledger."""
+    r = R_GRAIN
+    s = scales(material, r)
+    lmp.commands_string(f"""
+        units si
+        atom_style sphere
+        atom_modify map array
+        boundary f f f
+        newton {newton}
+        comm_modify vel yes
+        region box block {-box} {box} {-box} {box} {-box} {box}
+        create_box 1 box
+        create_atoms 1 single 0 0 0
+        create_atoms 1 single {separation!r} 0 0
+        set type 1 diameter {2 * r!r}
+        set type 1 density {material.density!r}
+        velocity all set 0 0 0
+        set atom 1 vx {0.5 * v_rel!r}
+        set atom 2 vx {-0.5 * v_rel!r}
+        pair_style jkr/dt
+        pair_coeff * * gamma {material.gamma!r} E {material.E!r} nu {material.nu!r} {coeff_extra}
+        neighbor {2 * s.delta_c!r} bin
+        neigh_modify every 1 delay 0 check yes
+        fix integrate all nve/sphere
+        compute p all pair jkr/dt
+        compute erot all erotate/sphere
+        thermo_style custom {ENERGY_THERMO}
+        thermo_modify norm no
+        timestep {dt_over_tc * s.t_c!r}
+    """)
+    return s
+
+
+def ledger(lmp):
+    """Energies at the current step: ke, erot, pe, the 10 values of compute pair
+    jkr/dt as p1..p10, 'dissipated' (slots 5-9) and 'total', the conserved sum."""
+    p = lmp.numpy.extract_compute("p", 0, 1)
+    e = {f"p{k + 1}": float(p[k]) for k in range(10)}
+    e["ke"] = lmp.get_thermo("ke")
+    e["pe"] = lmp.get_thermo("pe")
+    e["erot"] = float(lmp.extract_compute("erot", 0, 0))
+    e["dissipated"] = sum(e[f"p{k}"] for k in range(5, 10))
+    e["total"] = e["ke"] + e["erot"] + e["pe"] + e["dissipated"]
+    return e
+
+
+@pytest.fixture
+def lmp():
+    instance = start_lammps()
+    yield instance
+    instance.close()
+
+
+def atom_force_x(lmp, atom_id):
+    ids = lmp.numpy.extract_atom("id")
+    f = lmp.numpy.extract_atom("f")
+    return float(f[list(ids).index(atom_id), 0])
+
+
+__all__ = ["R_GRAIN", "ICE_SCALES", "jkr_force", "jkr_potential", "jkr_sqrt_radius",
+           "two_grain_scene", "ledger", "atom_force_x", "math"]

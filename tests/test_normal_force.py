@@ -1,0 +1,73 @@
+"""The JKR normal interaction against eqs. (4)-(6) and (45) of Wada et al. (2007)."""
+
+import numpy as np
+import pytest
+
+from conftest import ICE_SCALES as S, R_GRAIN, atom_force_x, jkr_force, jkr_potential, \
+    ledger, two_grain_scene
+
+U_EQUILIBRIUM = -0.8 * 6 ** (1 / 3)        # U_n(delta0) / (F_c delta_c), eq. (6) at a = a0
+E_BREAK = 4 / 45 + 0.8 * 6 ** (1 / 3)      # eq. (45) / (A.7), ~1.5426
+
+
+def place(lmp, delta):
+    """Move grain 2 to compression ``delta`` and evaluate forces (run 0)."""
+    lmp.command(f"set atom 2 x {float(2 * R_GRAIN - delta)!r}")
+    lmp.command("run 0")
+
+
+def test_rest_at_equilibrium_has_no_force_and_energy_u_delta0(lmp):
+    two_grain_scene(lmp, 2 * R_GRAIN - S.delta0)
+    lmp.command("run 0")
+    e = ledger(lmp)
+    # round-off of delta: |x| ~ 2e-7 m carries ~3e-23 m error against delta0 ~ 1e-9 m
+    assert abs(atom_force_x(lmp, 1)) < 1e-11 * S.F_c
+    assert e["pe"] / (S.F_c * S.delta_c) == pytest.approx(U_EQUILIBRIUM, rel=1e-10)
+    assert e["p10"] == 1
+
+
+def test_force_follows_eq5_over_compression_and_tensile_branch(lmp):
+    two_grain_scene(lmp, 2 * R_GRAIN - S.delta0)
+    lmp.command("run 0")                                   # the contact forms at delta0
+    deltas = np.concatenate([np.linspace(-0.9999, 0, 40) * S.delta_c,
+                             np.linspace(0, 5, 40) * S.delta0,
+                             [20 * S.delta0, 50 * S.delta0]])    # large: 50 delta0 is half a radius
+    for delta in deltas:
+        place(lmp, delta)
+        expected = jkr_force(delta, S)
+        # atom 1 sits at smaller x: a repulsive force pushes it to -x
+        assert -atom_force_x(lmp, 1) == pytest.approx(expected, rel=1e-9, abs=1e-10 * S.F_c), delta
+        assert ledger(lmp)["pe"] == pytest.approx(jkr_potential(delta, S), rel=1e-9,
+                                                      abs=1e-10 * S.F_c * S.delta_c)
+
+
+def test_tensile_force_at_break_point_and_break_beyond(lmp):
+    two_grain_scene(lmp, 2 * R_GRAIN - S.delta0)
+    lmp.command("run 0")
+    place(lmp, -(1 - 1e-9) * S.delta_c)
+    # at a/a0 = 6^(-2/3): F = 4 (1/36 - 1/6) F_c = -5/9 F_c
+    assert -atom_force_x(lmp, 1) == pytest.approx(-5 / 9 * S.F_c, rel=1e-4)
+    assert ledger(lmp)["p10"] == 1
+    place(lmp, -(1 + 1e-9) * S.delta_c)
+    assert atom_force_x(lmp, 1) == 0.0
+    assert ledger(lmp)["p10"] == 0
+    assert ledger(lmp)["pe"] == 0.0
+    place(lmp, -0.5 * S.delta_c)                           # no re-forming while apart
+    assert atom_force_x(lmp, 1) == 0.0 and ledger(lmp)["p10"] == 0
+
+
+def test_no_contact_before_touching(lmp):
+    two_grain_scene(lmp, 2 * R_GRAIN + 0.5 * S.delta_c)
+    lmp.command("run 0")
+    assert atom_force_x(lmp, 1) == 0.0 and ledger(lmp)["p10"] == 0
+
+
+def test_breaking_energy_from_plugin_energies_is_eq45(lmp):
+    two_grain_scene(lmp, 2 * R_GRAIN - S.delta0)
+    lmp.command("run 0")
+    u_eq = ledger(lmp)["pe"]
+    place(lmp, -(1 - 1e-12) * S.delta_c)
+    u_break = ledger(lmp)["pe"]
+    # the last bonded position is 1e-12 delta_c short of the break: dU = 5/9 F_c * 1e-12 delta_c
+    assert (u_break - u_eq) / (S.F_c * S.delta_c) == pytest.approx(E_BREAK, rel=1e-9)
+    assert E_BREAK == pytest.approx(1.5426, abs=1e-4)
