@@ -1,0 +1,110 @@
+"""Every misuse of the input stops with a LAMMPS error that names the problem and the fix."""
+
+import pytest
+
+from jkrdt.session import start_lammps
+
+BASE = """
+units si
+atom_style {style}
+atom_modify map array
+boundary {boundary}
+newton off
+{comm}
+region box block -1e-6 1e-6 -1e-6 1e-6 -1e-6 1e-6
+create_box 1 box
+create_atoms 1 single 0 0 0
+create_atoms 1 single 1.99e-7 0 0
+{diameter}
+pair_style jkr/dt
+{coeff}
+neighbor 1e-9 bin
+"""
+GOOD_COEFF = "pair_coeff * * gamma 0.1 E 7e9 nu 0.25 frictionless"
+
+
+def run_deck(style="sphere", comm="comm_modify vel yes", coeff=GOOD_COEFF,
+             diameter="set type 1 diameter 2e-7", boundary="f f f", tail="run 0"):
+    lmp = start_lammps()
+    try:
+        lmp.commands_string(BASE.format(style=style, comm=comm, coeff=coeff,
+                                        diameter=diameter, boundary=boundary))
+        lmp.commands_string(tail)
+    finally:
+        lmp.close()
+
+
+def expect_error(match, **kwargs):
+    with pytest.raises(Exception, match=match):
+        run_deck(**kwargs)
+
+
+def test_good_deck_runs():
+    run_deck()
+
+
+def test_atom_style_without_radius():
+    expect_error("requires atom_style sphere", style="atomic", diameter="mass 1 1e-17")
+
+
+def test_ghost_velocities_missing():
+    expect_error("comm_modify vel yes", comm="")
+
+
+def test_type_material_incomplete():
+    expect_error("gamma, E and nu", coeff="pair_coeff * * gamma 0.1 frictionless")
+
+
+def test_e_without_nu():
+    expect_error("E and nu go together", coeff="pair_coeff * * gamma 0.1 E 7e9 frictionless")
+
+
+def test_unknown_keyword():
+    expect_error("unknown keyword 'gama'", coeff="pair_coeff * * gama 0.1 E 7e9 nu 0.25")
+
+
+@pytest.mark.parametrize("word,value,message", [
+    ("gamma", "-1", "gamma must be > 0"), ("E", "0", "E must be > 0"),
+    ("nu", "0.7", "nu must lie in"), ("tvis", "-1e-12", "tvis must be >= 0"),
+    ("xi_crit", "0", "xi_crit must be > 0")])
+def test_out_of_range_values(word, value, message):
+    words = {"gamma": "0.1", "E": "7e9", "nu": "0.25"}
+    words[word] = value
+    coeff = "pair_coeff * * " + " ".join(f"{k} {v}" for k, v in words.items())
+    expect_error(message, coeff=coeff + " rolling off")
+
+
+def test_keyword_without_value():
+    expect_error("needs a value", coeff="pair_coeff * * gamma 0.1 E 7e9 nu 0.25 tvis")
+
+
+def test_rolling_needs_xi_crit():
+    expect_error("xi_crit is not set", coeff="pair_coeff * * gamma 0.1 E 7e9 nu 0.25")
+
+
+def test_damping_with_zero_poisson_ratio():
+    expect_error("divides by nu", coeff="pair_coeff * * gamma 0.1 E 7e9 nu 0 tvis 6e-12 frictionless")
+
+
+def test_zero_radius():
+    expect_error("finite radius > 0", diameter="set atom 1 diameter 0")
+
+
+def test_periodic_box_too_small():
+    expect_error("two images of one contact partner", boundary="p p p",
+                 diameter="set type 1 diameter 1.5e-6")
+
+
+def test_pair_style_arguments():
+    lmp = start_lammps()
+    try:
+        with pytest.raises(Exception, match="takes no arguments"):
+            lmp.command("pair_style jkr/dt 1.0")
+    finally:
+        lmp.close()
+
+
+def test_contact_escaping_the_neighbor_list():
+    # a bonded pair pulled out of neighbor range in one jump, between two runs
+    expect_error("no longer in the neighbor list",
+                 tail="run 0\nset atom 2 x 9e-7\nrun 0")
