@@ -1,0 +1,112 @@
+"""Command line: ``jkrdt demo`` builds two BPCA ice aggregates, collides them in
+LAMMPS with pair jkr/dt, and reports the outcome with a picture."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from . import collision
+from .aggregates import bpca
+from .materials import material, scales
+
+DECK = "collision.lmp"
+
+
+def find_deck() -> Path:
+    here = Path(__file__).resolve()
+    for base in [Path.cwd(), *here.parents]:
+        deck = base / "inputs" / DECK
+        if deck.exists():
+            return deck
+    raise FileNotFoundError(f"inputs/{DECK} not found; run from the repository root")
+
+
+def run_lammps(deck: Path, out: Path, variables: dict, nproc: int = 1) -> None:
+    lmp = Path(sys.executable).parent / "lmp"
+    cmd = [str(lmp), "-in", str(deck), "-log", str(out / "log.lammps"), "-screen", "none"]
+    for k, v in variables.items():
+        cmd += ["-var", k, str(v)]
+    if nproc > 1:
+        cmd = [str(Path(sys.executable).parent / "mpirun"), "-np", str(nproc)] + cmd
+    subprocess.run(cmd, check=True, cwd=out)
+
+
+def last_contacts(path: Path) -> np.ndarray:
+    text = path.read_text().split("ITEM: TIMESTEP")[-1]
+    body = text.split("ITEM: ENTRIES")[-1].splitlines()[1:]
+    rows = [line.split()[:2] for line in body if line.strip()]
+    return np.array(rows, dtype=float).astype(int).reshape(-1, 2)
+
+
+def demo(args) -> int:
+    from jkrdt.analysis.outcome import fragments, outcome
+    from jkrdt.analysis.plots import snapshot
+    from jkrdt.analysis.thermo import energy_budget, read_thermo
+
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    mat = material("ice")
+    r = 1.0e-7
+    s = scales(mat, r)
+    rng = np.random.default_rng(args.seed)
+    t0 = time.time()
+    tar = bpca(args.n, r, s.delta0, rng)
+    pro = bpca(args.n, r, s.delta0, rng)
+    c = collision.set_up(tar, pro, r, v_col=args.v, b_off=args.b_off, rng=rng,
+                         material=mat, seed=args.seed)
+    data = collision.write(c, mat, out)
+    print(f"built 2 BPCA of {args.n} grains and set up the collision in {time.time() - t0:.1f} s")
+
+    dt = 0.014 * s.t_c
+    t0 = time.time()
+    run_lammps(find_deck(), out, dict(file=data, out=out, steps=args.steps, every=args.steps // 20,
+                                      dt=dt, model="frictionless"), nproc=args.np)
+    wall = time.time() - t0
+    print(f"ran {args.steps} steps of {2 * args.n} grains in {wall:.1f} s on {args.np} rank(s)")
+
+    final = np.loadtxt(out / "final.dump", skiprows=9)
+    final = final[np.argsort(final[:, 0])]
+    pairs = last_contacts(out / "contacts.dump")
+    result = outcome(final[:, 1:4], pairs, args.n, args.n)
+    budget = energy_budget(read_thermo(out / "log.lammps"))
+    e_imp = c.meta["E_imp"]
+    error = float(np.abs(budget["total"] - budget["total"][0]).max() / e_imp)
+    pictures = snapshot(out / "outcome", final[:, 1:4], fragments(len(final), pairs),
+                        f"ice BPCA {args.n}+{args.n}, v = {args.v} m/s, B_off = {args.b_off}, "
+                        f"frictionless")
+    summary = dict(dataclass=result.__dict__, E_imp=e_imp, energy_error=error,
+                   dissipated_fraction=float(budget["dissipated"][-1] / e_imp), wall_seconds=wall)
+    (out / "summary.json").write_text(json.dumps(summary, indent=2, default=float))
+    print()
+    print(result.summary())
+    print(f"impact energy E_imp         {e_imp:.3e} J")
+    print(f"dissipated / E_imp          {summary['dissipated_fraction']:.3f}")
+    print(f"max |dE| / E_imp            {error:.2e}")
+    print(f"picture                     {pictures[0]}")
+    return 0
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="jkrdt", description=__doc__)
+    sub = parser.add_subparsers(dest="command", required=True)
+    d = sub.add_parser("demo", help="collide two BPCA ice aggregates and report the outcome")
+    d.add_argument("--n", type=int, default=500, help="grains per aggregate")
+    d.add_argument("--v", type=float, default=20.0, help="collision speed, m/s")
+    d.add_argument("--b-off", type=float, default=0.3, help="impact parameter B_off")
+    d.add_argument("--steps", type=int, default=40000)
+    d.add_argument("--np", type=int, default=1, help="MPI ranks")
+    d.add_argument("--seed", type=int, default=1)
+    d.add_argument("--out", default="runs/demo")
+    args = parser.parse_args(argv)
+    return demo(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
