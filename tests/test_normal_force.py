@@ -71,3 +71,23 @@ def test_breaking_energy_from_plugin_energies_is_eq45(lmp):
     # the last bonded position is 1e-12 delta_c short of the break: dU = 5/9 F_c * 1e-12 delta_c
     assert (u_break - u_eq) / (S.F_c * S.delta_c) == pytest.approx(E_BREAK, rel=1e-9)
     assert E_BREAK == pytest.approx(1.5426, abs=1e-4)
+
+
+def test_unequal_radii_use_the_reduced_radius(lmp):
+    # r1 = 0.1 micron, r2 = 0.05 micron: R = r1 r2 / (r1 + r2), eq. (2)
+    from jkrdt.materials import ICE
+    r1, r2 = R_GRAIN, 0.5 * R_GRAIN
+    R = r1 * r2 / (r1 + r2)
+    Estar = ICE.E / (2 * (1 - ICE.nu ** 2))
+    a0 = (9 * np.pi * ICE.gamma * R ** 2 / Estar) ** (1 / 3)
+    delta0 = a0 ** 2 / (3 * R)
+    F_c, delta_c = 3 * np.pi * ICE.gamma * R, (9 / 16) ** (1 / 3) * delta0
+    two_grain_scene(lmp, r1 + r2 - delta0)
+    lmp.command(f"set atom 2 diameter {2 * r2!r}")
+    lmp.command("run 0")
+    assert abs(atom_force_x(lmp, 1)) < 1e-10 * F_c
+    assert ledger(lmp)["pe"] / (F_c * delta_c) == pytest.approx(U_EQUILIBRIUM, rel=1e-9)
+    lmp.command(f"set atom 2 x {float(r1 + r2 + 0.5 * delta_c)!r}")     # tensile, -delta_c/2
+    lmp.command("run 0")
+    s = type("Scales", (), dict(F_c=F_c, delta0=delta0, delta_c=delta_c))
+    assert -atom_force_x(lmp, 1) == pytest.approx(jkr_force(-0.5 * delta_c, s), rel=1e-9)
