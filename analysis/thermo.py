@@ -11,7 +11,7 @@ LEDGER = ["c_p[5]", "c_p[6]", "c_p[7]", "c_p[8]", "c_p[9]"]   # dissipated, by c
 
 def read_thermo(log) -> dict[str, np.ndarray]:
     """Columns of every thermo block in ``log``, concatenated (repeated steps dropped)."""
-    columns, rows = None, []
+    columns, columns_done, rows = None, None, []
     for line in Path(log).read_text().splitlines():
         words = line.split()
         if words and words[0] == "Step":

@@ -1,7 +1,5 @@
 """Shared scenes for the tests: real LAMMPS instances with pair jkr/dt."""
 
-import math
-
 import numpy as np
 import pytest
 
@@ -97,4 +95,4 @@ def atom_force_x(lmp, atom_id):
 
 
 __all__ = ["R_GRAIN", "ICE_SCALES", "jkr_force", "jkr_potential", "jkr_sqrt_radius",
-           "two_grain_scene", "ledger", "atom_force_x", "math"]
+           "two_grain_scene", "ledger", "atom_force_x"]

@@ -1,8 +1,6 @@
 """Contact state survives reneighboring, MPI decomposition, newton settings and
 restarts: the same aggregate collision gives the same trajectory to round-off."""
 
-import os
-import shutil
 import subprocess
 import sys
 from pathlib import Path
