@@ -47,6 +47,7 @@ class FixJKRDTContacts : public Fix {
   double *add(int i, tagint partner_tag);
   void remove(int i, int k);
   double *contact_values(int i, int k) { return values[i] + k * dnum; }
+  const double *contact_values(int i, int k) const { return values[i] + k * dnum; }
 
   void grow_arrays(int) override;
   void copy_arrays(int, int, int) override;

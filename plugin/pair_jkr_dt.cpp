@@ -376,7 +376,8 @@ void PairJKRDT::fill_pvector(double upot)
 bool PairJKRDT::bonded_contact(int i, int j, ContactView &view) const
 {
   const tagint *tag = atom->tag;
-  if (fix_contacts->find(i, tag[j]) < 0) return false;
+  const int k = fix_contacts->find(i, tag[j]);
+  if (k < 0) return false;
   int p = i, q = j;
   if (tag[q] < tag[p]) std::swap(p, q);
   double **x = atom->x;
@@ -392,7 +393,7 @@ bool PairJKRDT::bonded_contact(int i, int j, ContactView &view) const
   view.force = S.F_c * JKRDT::normal_force_ratio(y);
   if (P.damp_coef > 0.0) {
     const auto &C = *fix_contacts;
-    view.force -= C.values[i][C.find(i, tag[j]) * C.dnum + C.offset(Contacts::DAMPING_FORCE)];
+    view.force -= C.contact_values(i, k)[C.offset(Contacts::DAMPING_FORCE)];
   }
   return true;
 }

@@ -10,6 +10,7 @@ import pytest
 
 from jkrdt import collision
 from jkrdt.aggregates import bpca
+from jkrdt.analysis.dumps import last_local_snapshot
 from jkrdt.materials import ICE, scales
 
 DECK = Path(__file__).resolve().parents[1] / "inputs" / "collision.lmp"
@@ -45,9 +46,7 @@ def run_deck(workdir, data, nproc=1, steps=STEPS, restart=None, extra=()):
 
 def last_local_dump(workdir):
     """Rows of the last snapshot of the deck's contacts.dump (dump local)."""
-    text = (workdir / "contacts.dump").read_text().split("ITEM: TIMESTEP")[-1]
-    body = text.split("ITEM: ENTRIES")[-1].splitlines()[1:]
-    return np.array([[float(w) for w in line.split()] for line in body if line.strip()])
+    return last_local_snapshot(workdir / "contacts.dump")
 
 
 def scale_error(a, b):

@@ -42,14 +42,8 @@ def run_lammps(deck: Path, out: Path, variables: dict, nproc: int = 1) -> None:
         raise SystemExit("LAMMPS failed:\n" + "\n".join(errors) + f"\n(full log: {out / 'log.lammps'})")
 
 
-def last_contacts(path: Path) -> np.ndarray:
-    text = path.read_text().split("ITEM: TIMESTEP")[-1]
-    body = text.split("ITEM: ENTRIES")[-1].splitlines()[1:]
-    rows = [line.split()[:2] for line in body if line.strip()]
-    return np.array(rows, dtype=float).astype(int).reshape(-1, 2)
-
-
 def demo(args) -> int:
+    from jkrdt.analysis.dumps import last_local_snapshot
     from jkrdt.analysis.outcome import fragments, outcome
     from jkrdt.analysis.plots import snapshot
     from jkrdt.analysis.thermo import energy_budget, read_thermo
@@ -77,7 +71,7 @@ def demo(args) -> int:
 
     final = np.loadtxt(out / "final.dump", skiprows=9)
     final = final[np.argsort(final[:, 0])]
-    pairs = last_contacts(out / "contacts.dump")
+    pairs = last_local_snapshot(out / "contacts.dump")[:, :2].astype(int)
     result = outcome(final[:, 1:4], pairs, args.n, args.n)
     budget = energy_budget(read_thermo(out / "log.lammps"))
     e_imp = c.meta["E_imp"]
