@@ -73,6 +73,9 @@ void ComputeJKRDTContacts::compute_local()
           row[2] = view.delta;
           row[3] = view.a;
           row[4] = view.force;
+          row[5] = view.zeta;
+          row[6] = view.xi;
+          row[7] = view.phi;
         }
         n++;
       }

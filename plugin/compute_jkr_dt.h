@@ -1,7 +1,8 @@
 /* jkr/dt: contact output.
 
    compute ID group jkr/dt/contacts       local array, one row per bonded contact:
-                                          id1 id2 delta a force   (for dump local)
+                                          id1 id2 delta a force |zeta| |xi| |phi|
+                                          (for dump local; a channel that is off gives 0)
    compute ID group jkr/dt/coordination   per-atom number of bonded contacts
 
    A contact is listed once, by the rank that owns its atom with the smaller ID,
@@ -18,7 +19,7 @@ class PairJKRDT;
 
 class ComputeJKRDTContacts : public Compute {
  public:
-  static constexpr int NCOLS = 5;
+  static constexpr int NCOLS = 8;
   ComputeJKRDTContacts(class LAMMPS *, int, char **);
   ~ComputeJKRDTContacts() override;
   void init() override;

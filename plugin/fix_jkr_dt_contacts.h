@@ -27,9 +27,12 @@ namespace LAMMPS_NS {
 
 class FixJKRDTContacts : public Fix {
  public:
-  // per-contact value fields, each present only when its bit is in the layout mask
-  enum Field { DAMPING_FORCE = 0, NFIELD };
-  static constexpr int FIELD_SIZE[NFIELD] = {1};
+  // per-contact value fields, each present only when its bit is in the layout mask:
+  //   DAMPING_FORCE  F_D of eq. (A.5) at the last step          (tvis > 0)
+  //   POINTERS       contact pointers n1, n2, section 2.2.4      (sliding or rolling)
+  //   TWIST          twisting angle phi, eq. (24)                (twisting)
+  enum Field { DAMPING_FORCE = 0, POINTERS, TWIST, NFIELD };
+  static constexpr int FIELD_SIZE[NFIELD] = {1, 6, 1};
 
   // ledger columns: energy dissipated by channel
   enum Ledger { FORM_BREAK = 0, DAMPING, SLIDING, ROLLING, TWISTING, NLEDGER };

@@ -9,13 +9,20 @@
    evaluated in its canonical orientation (particle 1 = smaller atom ID), so
    the two ranks do the same arithmetic on the same numbers.
 
-   Energy. pe holds the contact potentials U_n, eq. (6). The energy that
+   The tangential channels (sliding, rolling, twisting; section 2.2) of a
+   contact are advanced in pair_jkr_dt_tangential.cpp; their forces and
+   torques are added here.
+
+   Energy. pe holds the contact potentials U_n + U_s + U_r + U_t, eqs. (6),
+   (11), (21), (25). The energy that
    leaves the mechanical budget is booked per channel in the contact fix's
    per-atom ledger, half to each atom of the contact:
      formation, breaking  the jump of U_n (section 2.1) as the integrator
                 meets it: see event_loss() in jkr_dt_normal.h
      damping    the work of F_D of eq. (A.5) across the two half-kicks of
                 velocity Verlet that apply it: F_D(n) (v_rel(n-1/2) + v_rel(n+1/2)) dt / 2
+     sliding, rolling, twisting  the inelastic clamps of section 2.2.5 and
+                the springs' energy when a contact breaks
    so that ke + erotate + pe + (dissipated) stays constant.
    Contacts present when a run starts (the force evaluation of setup) are
    taken as given: they book nothing.                                        */
@@ -46,7 +53,8 @@ const char *const PairJKRDT::FIX_ID = "JKR_DT_CONTACTS";
 /* ---------------------------------------------------------------------- */
 
 PairJKRDT::PairJKRDT(LAMMPS *lmp) :
-    Pair(lmp), fix_contacts(nullptr), visited(nullptr), nmax_visited(0), nstride(0)
+    Pair(lmp), fix_contacts(nullptr), visited(nullptr), nmax_visited(0), nstride(0),
+    any_tangential(false)
 {
   single_enable = 0;
   restartinfo = 1;
@@ -82,13 +90,21 @@ void PairJKRDT::init_style()
                "pair jkr/dt requires velocities of ghost atoms: add 'comm_modify vel yes'");
   if (!atom->tag_enable)
     error->all(FLERR, "pair jkr/dt requires atom IDs: contacts are keyed by the IDs of the pair");
+  if (!atom->torque_flag)
+    error->all(FLERR, "pair jkr/dt requires per-atom torque: use atom_style sphere");
+  if (update->whichflag == 2)
+    error->all(FLERR,
+               "pair jkr/dt cannot be minimized: its contacts carry history (pointers, twist, "
+               "breaking). Relax with a damped run instead (e.g. fix viscous)");
 
   find_max_radii();
   double cutmax = 0.0;
+  any_tangential = false;
   for (int i = 1; i <= atom->ntypes; i++)
     for (int j = i; j <= atom->ntypes; j++) {
       param[i * nstride + j] = resolve(i, j);
       cutmax = std::max(cutmax, par(i, j).cut);
+      any_tangential = any_tangential || par(i, j).tangential();
     }
   check_periodic_images(cutmax);
 
@@ -113,8 +129,12 @@ int PairJKRDT::layout_mask() const
 {
   int mask = 0;
   for (int i = 1; i <= atom->ntypes; i++)
-    for (int j = i; j <= atom->ntypes; j++)
-      if (par(i, j).damp_coef > 0.0) mask |= 1 << Contacts::DAMPING_FORCE;
+    for (int j = i; j <= atom->ntypes; j++) {
+      const Param &P = par(i, j);
+      if (P.damp_coef > 0.0) mask |= 1 << Contacts::DAMPING_FORCE;
+      if (P.sliding || P.rolling) mask |= 1 << Contacts::POINTERS;
+      if (P.twisting) mask |= 1 << Contacts::TWIST;
+    }
   return mask;
 }
 
@@ -175,6 +195,7 @@ void PairJKRDT::compute(int eflag, int vflag)
   double **x = atom->x;
   double **v = atom->v;
   double **f = atom->f;
+  double **torque = atom->torque;
   const double *radius = atom->radius;
   const tagint *tag = atom->tag;
   const int *type = atom->type;
@@ -191,8 +212,11 @@ void PairJKRDT::compute(int eflag, int vflag)
     memory->create(visited, nmax_visited, "jkr/dt:visited");
   }
   std::fill(visited, visited + nlocal, 0);
+  if (any_tangential && !setup) spin_rotations();
 
   double upot = 0.0;
+  double utan[JKRDT::NCHANNEL] = {0.0, 0.0, 0.0};
+  JKRDT::ChannelLoad load[JKRDT::NCHANNEL];
   const int inum = list->inum;
   const int *ilist = list->ilist;
   const int *numneigh = list->numneigh;
@@ -250,6 +274,7 @@ void PairJKRDT::compute(int eflag, int vflag)
             book(Contacts::DAMPING, 0.5 * dt * fd_prev * vn, p, q, nlocal);
           }
         }
+        if (P.tangential()) tangential_step(p, q, P, S, state_p, state_q, false, true, load);
         if (p_own) C.remove(p, kp);
         if (q_own) C.remove(q, kq);
         continue;
@@ -281,28 +306,52 @@ void PairJKRDT::compute(int eflag, int vflag)
         fmag -= fd;
       }
 
+      // force on p: normal (eq. 5 and A.5) plus sliding (eq. 14); torques eqs. (17), (23), (27)
       const double fpair = fmag * rinv;
+      JKRDT::V3 fp = {delx * fpair, dely * fpair, delz * fpair};
+      JKRDT::V3 mp = {0.0, 0.0, 0.0}, mq = mp;
+      double u_t = 0.0;
+      if (P.tangential()) {
+        tangential_step(p, q, P, S, state_p, state_q, formed, false, load);
+        for (int ch = 0; ch < JKRDT::NCHANNEL; ch++) {
+          fp = fp + load[ch].F1;
+          mp = mp + load[ch].M1;
+          mq = mq + load[ch].M2;
+          u_t += load[ch].U;
+        }
+      }
+      const double share = 0.5 * ((p_own ? 1.0 : 0.0) + (q_own ? 1.0 : 0.0));
       if (p_own) {
-        f[p][0] += delx * fpair;
-        f[p][1] += dely * fpair;
-        f[p][2] += delz * fpair;
+        f[p][0] += fp.x;
+        f[p][1] += fp.y;
+        f[p][2] += fp.z;
+        torque[p][0] += mp.x;
+        torque[p][1] += mp.y;
+        torque[p][2] += mp.z;
         visited[p]++;
       }
       if (q_own) {
-        f[q][0] -= delx * fpair;
-        f[q][1] -= dely * fpair;
-        f[q][2] -= delz * fpair;
+        f[q][0] -= fp.x;
+        f[q][1] -= fp.y;
+        f[q][2] -= fp.z;
+        torque[q][0] += mq.x;
+        torque[q][1] += mq.y;
+        torque[q][2] += mq.z;
         visited[q]++;
       }
-      if (eflag) upot += 0.5 * ((p_own ? 1.0 : 0.0) + (q_own ? 1.0 : 0.0)) * u_n;
-      if (evflag) ev_tally(p, q, nlocal, 0, u_n, 0.0, fpair, delx, dely, delz);
+      if (eflag) {
+        upot += share * u_n;
+        if (P.tangential())
+          for (int ch = 0; ch < JKRDT::NCHANNEL; ch++) utan[ch] += share * load[ch].U;
+      }
+      if (evflag) ev_tally_xyz(p, q, nlocal, 0, u_n + u_t, 0.0, fp.x, fp.y, fp.z, delx, dely, delz);
     }
   }
 
   for (int i = 0; i < nlocal; i++)
     if (visited[i] != C.npartner[i]) report_unvisited_contact();
 
-  if (eflag_global) fill_pvector(upot);
+  if (eflag_global) fill_pvector(upot, utan);
 }
 
 /* ----------------------------------------------------------------------
@@ -356,10 +405,11 @@ void PairJKRDT::report_unvisited_contact()
    sums them over ranks
 ------------------------------------------------------------------------- */
 
-void PairJKRDT::fill_pvector(double upot)
+void PairJKRDT::fill_pvector(double upot, const double *utan)
 {
   std::fill(pvector, pvector + NPVECTOR, 0.0);
-  pvector[0] = upot;    // U_n; slots 1-3 (U_s, U_r, U_t) come with the tangential channels
+  pvector[0] = upot;    // U_n
+  for (int ch = 0; ch < JKRDT::NCHANNEL; ch++) pvector[1 + ch] = utan[ch];    // U_s, U_r, U_t
   const auto &C = *fix_contacts;
   double contacts = 0.0;
   for (int i = 0; i < atom->nlocal; i++) {
@@ -391,9 +441,17 @@ bool PairJKRDT::bonded_contact(int i, int j, ContactView &view) const
   const double y = JKRDT::contact_sqrt_radius(view.delta / S.delta0);
   view.a = y * y * S.a0;
   view.force = S.F_c * JKRDT::normal_force_ratio(y);
-  if (P.damp_coef > 0.0) {
-    const auto &C = *fix_contacts;
-    view.force -= C.contact_values(i, k)[C.offset(Contacts::DAMPING_FORCE)];
+  const auto &C = *fix_contacts;
+  if (P.damp_coef > 0.0) view.force -= C.contact_values(i, k)[C.offset(Contacts::DAMPING_FORCE)];
+  view.zeta = view.xi = view.phi = 0.0;
+  JKRDT::ContactState c;
+  if (P.tangential() && read_state(C.contact_values(i, k), c)) {
+    const JKRDT::V3 nc = JKRDT::unit({dx, dy, dz});
+    if (P.sliding)
+      view.zeta = JKRDT::norm(JKRDT::tangential_part(
+          JKRDT::sliding_zeta0(c, nc, atom->radius[p], atom->radius[q]), nc));
+    if (P.rolling) view.xi = JKRDT::norm(JKRDT::rolling_xi(c, S.R));
+    if (P.twisting) view.phi = std::fabs(c.phi);
   }
   return true;
 }

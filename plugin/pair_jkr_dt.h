@@ -13,6 +13,7 @@
 #include "pair.h"
 
 #include "jkr_dt_normal.h"
+#include "jkr_dt_tangential.h"
 
 #include <vector>
 
@@ -25,6 +26,7 @@ class PairJKRDT : public Pair {
   // what pair_coeff gave for one type pair; NaN or -1 = not given
   struct Input {
     double gamma, E, nu, G, xi_crit, tvis;
+    double ks_scale, kr_scale, kt_scale;
     int sliding, rolling, twisting;
   };
 
@@ -32,7 +34,8 @@ class PairJKRDT : public Pair {
   struct Param {
     double gamma;       // surface energy
     double Estar;       // reduced Young's modulus, eq. (2)
-    double Gstar;       // reduced shear modulus, eq. (13)
+    double Gstar;       // G* of the sliding stiffness, eq. (13)
+    double Gred;        // reduced shear modulus (1/G1 + 1/G2)^-1 of eqs. (26), (35), (37)
     double nu;          // Poisson ratio in the damping of eq. (A.5)
     double xi_crit;     // critical rolling displacement (NaN if rolling is off)
     double tvis;        // viscoelastic time scale of eq. (A.5)
@@ -40,6 +43,11 @@ class PairJKRDT : public Pair {
     double damp_coef;   // 2 tvis E* / nu^2: F_D = damp_coef a v_rel
     double cut;         // reach of a stretched contact between the largest radii
     int sliding, rolling, twisting;
+    double ks_coef;     // k_s / a0 = 8 G* (times ks_scale), eq. (12)
+    double zeta_coef;   // zeta_crit / a0 = Gred / (16 pi G*), eqs. (35)-(36)
+    double k_r;         // 4 F_c / R = 12 pi gamma (times kr_scale), eq. (22)
+    double kt_coef;     // k_t / a0^3 = 16/3 Gred (times kt_scale), eq. (26)
+    bool tangential() const { return sliding || rolling || twisting; }
   };
 
   // one bonded contact, as the local compute reports it
@@ -48,6 +56,7 @@ class PairJKRDT : public Pair {
     double delta;       // compression length, eq. (3)
     double a;           // contact radius, eq. (4)
     double force;       // normal force on atom id1 along x1 - x2 (elastic + damping)
+    double zeta, xi, phi;    // |zeta|, |xi|, |phi|, eqs. (10), (20), (24); 0 if off
   };
 
   static constexpr int NPVECTOR = 10;
@@ -82,15 +91,25 @@ class PairJKRDT : public Pair {
   const Input &in(int i, int j) const { return input[i * nstride + j]; }
   const Param &par(int i, int j) const { return param[i * nstride + j]; }
 
+  std::vector<JKRDT::Rotation> spin;    // each atom's rotation over the step
+  bool any_tangential;
+
   void allocate();
   Param resolve(int i, int j) const;
+  JKRDT::Tangential tangential_constants(const Param &P, const JKRDT::NormalScales &S) const;
+  void spin_rotations();
+  bool read_state(const double *values, JKRDT::ContactState &c) const;
+  void write_state(double *values, const JKRDT::ContactState &c) const;
+  void tangential_step(int p, int q, const Param &P, const JKRDT::NormalScales &S,
+                       double *state_p, double *state_q, bool formed, bool breaking,
+                       JKRDT::ChannelLoad load[JKRDT::NCHANNEL]);
   int layout_mask() const;
   void find_max_radii();
   void check_periodic_images(double cutmax);
   void book(int channel, double energy, int p, int q, int nlocal);
   static double breaking_loss(double delta, double vn, double dt, const JKRDT::NormalScales &S);
   void report_unvisited_contact();
-  void fill_pvector(double upot);
+  void fill_pvector(double upot, const double *utan);
 };
 
 }    // namespace LAMMPS_NS

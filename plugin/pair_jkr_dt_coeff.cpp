@@ -4,6 +4,7 @@
      gamma <surface energy>   E <Young's modulus>   nu <Poisson ratio>
      G <shear modulus>        xi_crit <length>       tvis <time>
      sliding on|off   rolling on|off   twisting on|off   frictionless
+     ks_scale <f>     kr_scale <f>     kt_scale <f>
 
    A type's own line (I = J) gives its material: gamma, E and nu are required,
    G defaults to E / (2 (1 + nu)). A line for unlike types (I != J) may set any
@@ -11,8 +12,11 @@
      E*, G*   eqs. (2) and (13) from each type's E, nu, G
      gamma    geometric mean sqrt(gamma_I gamma_J)   (work of adhesion 2 sqrt(gamma_I gamma_J))
      nu       (in the damping of eq. A.5) arithmetic mean
-     xi_crit, tvis  arithmetic mean
+     xi_crit, tvis, scale factors  arithmetic mean
      channels on only where both types have them on
+   A scale factor multiplies its stiffness (k_s, k_r, k_t) and keeps the
+   critical displacement, so the critical force or torque, and E_roll,
+   scale with it.
    E, nu and G given on an unlike line are taken as the material of both
    particles of that pair.                                                   */
 
@@ -33,7 +37,8 @@
 using namespace LAMMPS_NS;
 
 static constexpr double UNSET = std::numeric_limits<double>::quiet_NaN();
-static const PairJKRDT::Input NOTHING_GIVEN = {UNSET, UNSET, UNSET, UNSET, UNSET, UNSET, -1, -1, -1};
+static const PairJKRDT::Input NOTHING_GIVEN = {UNSET, UNSET, UNSET, UNSET, UNSET, UNSET,
+                                               UNSET, UNSET, UNSET, -1,    -1,    -1};
 
 static bool given(double x) { return !std::isnan(x); }
 
@@ -98,6 +103,12 @@ void PairJKRDT::coeff(int narg, char **arg)
       g.G = positive(key);
     } else if (key == "xi_crit") {
       g.xi_crit = positive(key);
+    } else if (key == "ks_scale") {
+      g.ks_scale = positive(key);
+    } else if (key == "kr_scale") {
+      g.kr_scale = positive(key);
+    } else if (key == "kt_scale") {
+      g.kt_scale = positive(key);
     } else if (key == "nu") {
       g.nu = utils::numeric(FLERR, value(key), false, lmp);
       if (!(g.nu > -1.0 && g.nu < 0.5))
@@ -120,7 +131,7 @@ void PairJKRDT::coeff(int narg, char **arg)
     } else {
       error->all(FLERR,
                  "pair_coeff for jkr/dt: unknown keyword '{}'; allowed: gamma E nu G xi_crit "
-                 "tvis sliding rolling twisting frictionless",
+                 "tvis sliding rolling twisting frictionless ks_scale kr_scale kt_scale",
                  key);
     }
     iarg += 2;
@@ -163,6 +174,7 @@ PairJKRDT::Param PairJKRDT::resolve(int i, int j) const
   Param P;
   P.Estar = 1.0 / ((1.0 - m1.nu * m1.nu) / m1.E + (1.0 - m2.nu * m2.nu) / m2.E);    // eq. (2)
   P.Gstar = 1.0 / ((2.0 - m1.nu) / shear(m1) + (2.0 - m2.nu) / shear(m2));          // eq. (13)
+  P.Gred = 1.0 / (1.0 / shear(m1) + 1.0 / shear(m2));                               // below eq. (26)
   P.nu = 0.5 * (m1.nu + m2.nu);
 
   auto mean = [](double a, double b) { return 0.5 * (a + b); };
@@ -170,6 +182,13 @@ PairJKRDT::Param PairJKRDT::resolve(int i, int j) const
   P.gamma = (own && given(ij.gamma)) ? ij.gamma : std::sqrt(ii.gamma * jj.gamma);
   P.xi_crit = (own && given(ij.xi_crit)) ? ij.xi_crit : mean(ii.xi_crit, jj.xi_crit);
   P.tvis = (own && given(ij.tvis)) ? ij.tvis : mean(zero_if_unset(ii.tvis), zero_if_unset(jj.tvis));
+  auto scale = [&](double own_value, double a, double b) {
+    auto one_if_unset = [](double x) { return given(x) ? x : 1.0; };
+    return (own && given(own_value)) ? own_value : mean(one_if_unset(a), one_if_unset(b));
+  };
+  const double ks_scale = scale(ij.ks_scale, ii.ks_scale, jj.ks_scale);
+  const double kr_scale = scale(ij.kr_scale, ii.kr_scale, jj.kr_scale);
+  const double kt_scale = scale(ij.kt_scale, ii.kt_scale, jj.kt_scale);
 
   auto channel = [&](int own_flag, int a, int b) {
     if (own && own_flag >= 0) return own_flag;
@@ -193,6 +212,10 @@ PairJKRDT::Param PairJKRDT::resolve(int i, int j) const
 
   P.a0_coef = JKRDT::a0_coefficient(P.gamma, P.Estar);
   P.damp_coef = (P.tvis > 0.0) ? JKRDT::damping_coefficient(P.tvis, P.Estar, P.nu) : 0.0;
+  P.ks_coef = 8.0 * P.Gstar * ks_scale;                          // eq. (12)
+  P.zeta_coef = P.Gred / (16.0 * JKRDT::PI * P.Gstar);          // eqs. (35)-(36)
+  P.k_r = 12.0 * JKRDT::PI * P.gamma * kr_scale;                // eq. (22): 4 F_c / R
+  P.kt_coef = (16.0 / 3.0) * P.Gred * kt_scale;                 // eq. (26)
 
   // a stretched contact reaches r1 + r2 + delta_c; delta_c grows with R as R^(1/3)
   const double r1 = maxrad[i], r2 = maxrad[j];
@@ -217,9 +240,10 @@ double PairJKRDT::init_one(int i, int j)
 
 static void write_input(FILE *fp, const PairJKRDT::Input &g)
 {
-  const double d[6] = {g.gamma, g.E, g.nu, g.G, g.xi_crit, g.tvis};
+  const double d[9] = {g.gamma, g.E, g.nu, g.G, g.xi_crit, g.tvis,
+                       g.ks_scale, g.kr_scale, g.kt_scale};
   const int k[3] = {g.sliding, g.rolling, g.twisting};
-  fwrite(d, sizeof(double), 6, fp);
+  fwrite(d, sizeof(double), 9, fp);
   fwrite(k, sizeof(int), 3, fp);
 }
 
@@ -241,15 +265,15 @@ void PairJKRDT::read_restart(FILE *fp)
       if (me == 0) utils::sfread(FLERR, &setflag[i][j], sizeof(int), 1, fp, nullptr, error);
       MPI_Bcast(&setflag[i][j], 1, MPI_INT, 0, world);
       if (!setflag[i][j]) continue;
-      double d[6];
+      double d[9];
       int k[3];
       if (me == 0) {
-        utils::sfread(FLERR, d, sizeof(double), 6, fp, nullptr, error);
+        utils::sfread(FLERR, d, sizeof(double), 9, fp, nullptr, error);
         utils::sfread(FLERR, k, sizeof(int), 3, fp, nullptr, error);
       }
-      MPI_Bcast(d, 6, MPI_DOUBLE, 0, world);
+      MPI_Bcast(d, 9, MPI_DOUBLE, 0, world);
       MPI_Bcast(k, 3, MPI_INT, 0, world);
-      in(i, j) = {d[0], d[1], d[2], d[3], d[4], d[5], k[0], k[1], k[2]};
+      in(i, j) = {d[0], d[1], d[2], d[3], d[4], d[5], d[6], d[7], d[8], k[0], k[1], k[2]};
     }
 }
 
@@ -262,7 +286,10 @@ void PairJKRDT::write_data_all(FILE *fp)
       std::string line = fmt::format("{} {}", i, j);
       const std::pair<const char *, double> reals[] = {{"gamma", g.gamma}, {"E", g.E},
                                                        {"nu", g.nu},       {"G", g.G},
-                                                       {"xi_crit", g.xi_crit}, {"tvis", g.tvis}};
+                                                       {"xi_crit", g.xi_crit}, {"tvis", g.tvis},
+                                                       {"ks_scale", g.ks_scale},
+                                                       {"kr_scale", g.kr_scale},
+                                                       {"kt_scale", g.kt_scale}};
       for (const auto &kv : reals)
         if (given(kv.second)) line += fmt::format(" {} {:.17g}", kv.first, kv.second);
       const std::pair<const char *, int> flags[] = {

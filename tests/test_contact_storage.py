@@ -55,7 +55,7 @@ def test_twelve_contacts_on_one_grain(lmp):
     assert coord[list(ids).index(1)] == 12
     assert sorted(coord[list(ids).index(k)] for k in range(2, 14)) == [1] * 12
     rows = lmp.numpy.extract_compute("bonds", 2, 2)
-    assert rows.shape == (12, 5)
+    assert rows.shape == (12, 8)
     assert set(rows[:, 0]) == {1} and sorted(rows[:, 1]) == list(range(2, 14))
     assert np.allclose(rows[:, 2], S.delta0, rtol=1e-9)
     assert np.allclose(rows[:, 3], S.a0, rtol=1e-9)

@@ -1,0 +1,271 @@
+/* jkr/dt: the tangential interactions of Wada et al. (2007), section 2.2:
+   sliding, rolling and twisting, described by the contact pointers n1, n2
+   and the twisting angle phi, with the clamped inelasticity of section 2.2.5.
+
+   Stateless kernels, as in jkr_dt_normal.h: plain numbers in, plain numbers
+   out. Particle 1 is the atom with the smaller ID; n_c points from particle
+   2 to particle 1, eq. (9).
+
+   Notation (Wada et al. 2007):
+     zeta     sliding displacement                 eqs. (8)-(10)
+     xi       rolling displacement  R (n1 + n2)    eq. (20)
+     phi      twisting angle                       eq. (24)
+     k_s      8 a0 G*                              eqs. (12)-(13)
+     k_r      4 F_c / R = 12 pi gamma              eq. (22)
+     k_t      16/3 G a0^3, G the reduced shear modulus (1/G1 + 1/G2)^-1, eq. (26)
+     zeta_crit = F_fric / k_s, F_fric = G a0^2 / (2 pi), eqs. (35)-(36)
+     phi_crit  = M_fric / k_t = 1 / (16 pi),             eqs. (37)-(38)       */
+
+#ifndef JKR_DT_TANGENTIAL_H
+#define JKR_DT_TANGENTIAL_H
+
+#include "jkr_dt_normal.h"
+
+#include <cmath>
+
+namespace JKRDT {
+
+/* ---------------------------------------------------------------------
+   three-vectors
+------------------------------------------------------------------------ */
+
+struct V3 {
+  double x, y, z;
+};
+
+inline V3 vec(const double *a) { return {a[0], a[1], a[2]}; }
+inline void store(const V3 &a, double *out) { out[0] = a.x; out[1] = a.y; out[2] = a.z; }
+inline V3 operator+(const V3 &a, const V3 &b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline V3 operator-(const V3 &a, const V3 &b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline V3 operator-(const V3 &a) { return {-a.x, -a.y, -a.z}; }
+inline V3 operator*(double s, const V3 &a) { return {s * a.x, s * a.y, s * a.z}; }
+inline double dot(const V3 &a, const V3 &b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline double norm(const V3 &a) { return std::sqrt(dot(a, a)); }
+inline V3 cross(const V3 &a, const V3 &b)
+{
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline V3 unit(const V3 &a) { return (1.0 / norm(a)) * a; }
+
+/* ---------------------------------------------------------------------
+   tracing of the contact pointers, section 2.2.4
+
+   A pointer is fixed in its particle, so it turns with the particle's
+   rotation. Over one step the particle turns by omega dt, with omega its
+   angular velocity at the half step (the value velocity Verlet drifts
+   with): the rotation by the angle |omega| dt about omega (Rodrigues).
+   This is eqs. (32)-(33) integrated exactly over the step with omega held
+   at its half-step value: the rotational twin of x += v dt. It keeps the
+   scheme time-reversible and second order, and a pointer's length changes
+   only by round-off, which renormalization removes.
+------------------------------------------------------------------------ */
+
+struct Rotation {
+  double m[3][3];
+};
+
+inline Rotation spin_rotation(const double *omega, double dt)
+{
+  Rotation R;
+  const V3 w = dt * vec(omega);
+  const double angle = norm(w);
+  if (angle == 0.0) {
+    for (int a = 0; a < 3; a++)
+      for (int b = 0; b < 3; b++) R.m[a][b] = (a == b) ? 1.0 : 0.0;
+    return R;
+  }
+  const V3 k = (1.0 / angle) * w;
+  const double c = std::cos(angle), s = std::sin(angle), t = 1.0 - c;
+  const double kv[3] = {k.x, k.y, k.z};
+  for (int a = 0; a < 3; a++)
+    for (int b = 0; b < 3; b++) R.m[a][b] = t * kv[a] * kv[b] + ((a == b) ? c : 0.0);
+  R.m[0][1] -= s * k.z;
+  R.m[0][2] += s * k.y;
+  R.m[1][0] += s * k.z;
+  R.m[1][2] -= s * k.x;
+  R.m[2][0] -= s * k.y;
+  R.m[2][1] += s * k.x;
+  return R;
+}
+
+inline V3 rotate(const Rotation &R, const V3 &v)
+{
+  return unit({R.m[0][0] * v.x + R.m[0][1] * v.y + R.m[0][2] * v.z,
+               R.m[1][0] * v.x + R.m[1][1] * v.y + R.m[1][2] * v.z,
+               R.m[2][0] * v.x + R.m[2][1] * v.y + R.m[2][2] * v.z});
+}
+
+/* ---------------------------------------------------------------------
+   stiffnesses and elastic limits of one contact
+------------------------------------------------------------------------ */
+
+struct Tangential {
+  bool sliding, rolling, twisting;
+  double k_s, zeta_crit;    // eqs. (12), (36)
+  double k_r, xi_crit;      // eq. (22); xi_crit is a parameter
+  double k_t, phi_crit;     // eqs. (26), (38)
+};
+
+// phi_crit = M_t,fric / k_t, eqs. (37)-(38): 1/(16 pi), about 1.1 degrees
+inline double phi_crit() { return 1.0 / (16.0 * PI); }
+
+/* ---------------------------------------------------------------------
+   displacements, eqs. (8)-(10) and (20)
+------------------------------------------------------------------------ */
+
+struct ContactState {
+  V3 n1, n2;     // contact pointers
+  double phi;    // twisting angle along n_c, eq. (24)
+};
+
+// zeta_0, eq. (8)
+inline V3 sliding_zeta0(const ContactState &c, const V3 &nc, double r1, double r2)
+{
+  return r1 * c.n1 - r2 * c.n2 + (r1 + r2) * nc;
+}
+
+// zeta, the part of zeta_0 normal to n_c, eq. (10)
+inline V3 tangential_part(const V3 &a, const V3 &nc) { return a - dot(a, nc) * nc; }
+
+// xi = R (n1 + n2), eq. (20)
+inline V3 rolling_xi(const ContactState &c, double R) { return R * (c.n1 + c.n2); }
+
+/* ---------------------------------------------------------------------
+   potentials, forces and torques of each channel, eqs. (11)-(27)
+------------------------------------------------------------------------ */
+
+enum Channel { SLIDE = 0, ROLL, TWIST, NCHANNEL };
+
+struct ChannelLoad {
+  double U;    // potential, eqs. (11), (21), (25)
+  V3 F1;       // force on particle 1 (particle 2 gets -F1), eq. (14)
+  V3 M1, M2;   // torques on particles 1 and 2, eqs. (17), (23), (27)
+};
+
+// d12 = x1 - x2
+inline void tangential_load(const ContactState &c, const V3 &d12, double r1, double r2, double R,
+                            const Tangential &K, ChannelLoad load[NCHANNEL])
+{
+  const double dist = norm(d12);
+  const V3 nc = (1.0 / dist) * d12;    // eq. (9)
+  const V3 zero = {0.0, 0.0, 0.0};
+  for (int ch = 0; ch < NCHANNEL; ch++) load[ch] = {0.0, zero, zero, zero};
+
+  if (K.sliding) {
+    const V3 zeta0 = sliding_zeta0(c, nc, r1, r2);
+    const V3 zeta = tangential_part(zeta0, nc);
+    ChannelLoad &s = load[SLIDE];
+    s.U = 0.5 * K.k_s * dot(zeta, zeta);                                 // eq. (11)
+    s.F1 = (-K.k_s * (r1 + r2 - dot(zeta0, nc)) / dist) * zeta;          // eq. (14)
+    s.M1 = (-r1 * K.k_s) * cross(c.n1, zeta);                            // eq. (17)
+    s.M2 = (r2 * K.k_s) * cross(c.n2, zeta);                             // (17), 1 <-> 2, zeta -> -zeta
+  }
+  if (K.rolling) {
+    const V3 xi = rolling_xi(c, R);
+    ChannelLoad &r = load[ROLL];
+    r.U = 0.5 * K.k_r * dot(xi, xi);                                     // eq. (21)
+    r.M1 = (-R * K.k_r) * cross(c.n1, xi);                               // eq. (23)
+    r.M2 = (-R * K.k_r) * cross(c.n2, xi);
+  }
+  if (K.twisting) {
+    ChannelLoad &t = load[TWIST];
+    t.U = 0.5 * K.k_t * c.phi * c.phi;                                   // eq. (25)
+    t.M1 = (-K.k_t * c.phi) * nc;                                        // eq. (27)
+    t.M2 = -t.M1;
+  }
+}
+
+// work done on the particles by a channel's load over a step in which
+// particle 1 moves by dx1 and turns by dtheta1 (and likewise particle 2)
+inline double channel_work(const ChannelLoad &l, const V3 &dx12, const V3 &dtheta1,
+                           const V3 &dtheta2)
+{
+  return dot(l.F1, dx12) + dot(l.M1, dtheta1) + dot(l.M2, dtheta2);
+}
+
+/* ---------------------------------------------------------------------
+   inelastic regimes, section 2.2.5
+
+   A displacement beyond its elastic limit is brought back to the limit, so
+   that the force or torque stays at its critical value (Fig. 3). The
+   pointers are moved by eq. (42), with the factor alpha of eq. (A8) that
+   makes up for what renormalization takes off the shift.
+
+   Eq. (42) writes the sliding shifts of n1 and n2 with the same sign; with
+   zeta_0 = r1 n1 - r2 n2 + ..., n2 must move the other way, or the two
+   shifts cancel in zeta. For unequal radii the shifts are chosen so that
+   each correction leaves the other displacement unchanged:
+     sliding   n1 -= dzeta / (r1 + r2),   n2 += dzeta / (r1 + r2)   (xi unchanged)
+     rolling   n1 -= dxi / r1,            n2 -= dxi / r2            (zeta unchanged)
+   For r1 = r2 = r these are dzeta / 2r and dxi / 2R, as in eq. (42).
+------------------------------------------------------------------------ */
+
+// n - alpha shift, renormalized; alpha = 1 + 1/tan^2(theta1), eq. (A8), with
+// cos(theta1) the cosine between n and the shift, eq. (A5)
+inline V3 corrected_pointer(const V3 &n, const V3 &shift)
+{
+  const double l = norm(shift);
+  if (l == 0.0) return n;
+  const double cos1 = dot(n, shift) / l;
+  // a pointer lies within ~zeta_crit / r of the contact normal, nearly
+  // normal to the shift (alpha ~ 1); the bound only guards absurd states
+  const double sin2 = std::fmax(1.0 - cos1 * cos1, 0.5);
+  return unit(n - (1.0 / sin2) * shift);
+}
+
+// bring the displacements back to their elastic limits; returns a bit per
+// channel that was clamped
+inline int clamp_to_elastic_limits(ContactState &c, const V3 &nc, double r1, double r2, double R,
+                                   const Tangential &K)
+{
+  int clamped = 0;
+  if (K.sliding) {
+    const V3 zeta = tangential_part(sliding_zeta0(c, nc, r1, r2), nc);
+    const double z = norm(zeta);
+    if (z > K.zeta_crit) {
+      const V3 shift = ((1.0 - K.zeta_crit / z) / (r1 + r2)) * zeta;    // dzeta / (r1 + r2)
+      c.n1 = corrected_pointer(c.n1, shift);                            // eq. (42)
+      c.n2 = corrected_pointer(c.n2, -shift);
+      clamped |= 1 << SLIDE;
+    }
+  }
+  if (K.rolling) {
+    const V3 xi = rolling_xi(c, R);
+    const double x = norm(xi);
+    if (x > K.xi_crit) {
+      const V3 dxi = (1.0 - K.xi_crit / x) * xi;
+      c.n1 = corrected_pointer(c.n1, (1.0 / r1) * dxi);                 // eq. (42) for rolling
+      c.n2 = corrected_pointer(c.n2, (1.0 / r2) * dxi);
+      clamped |= 1 << ROLL;
+    }
+  }
+  if (K.twisting && std::fabs(c.phi) > K.phi_crit) {
+    c.phi = std::copysign(K.phi_crit, c.phi);
+    clamped |= 1 << TWIST;
+  }
+  return clamped;
+}
+
+/* ---------------------------------------------------------------------
+   energy dissipated in a step, eqs. (39)-(41) made exact for the scheme
+
+   Velocity Verlet changes the kinetic energy over a step by the trapezoid
+   of the work of the loads at its two ends (plus a term that telescopes).
+   The dissipation of a channel is what that work and the change of the
+   channel's potential leave over:
+     dE_dis = - (W_before + W_after) / 2 - (U_after - U_before)
+   For a clamp on the plateau this is k zeta_crit (|zeta| - zeta_crit),
+   eq. (39); on entering the plateau, and for the coupling between the
+   channels through the shared pointers, it is exact where eq. (39) is first
+   order. When the contact breaks, the load after is zero and the spring's
+   energy is lost: dE_dis = U_before - W_before / 2.
+------------------------------------------------------------------------ */
+
+inline double step_dissipation(double u_before, double w_before, double u_after, double w_after)
+{
+  return -0.5 * (w_before + w_after) - (u_after - u_before);
+}
+
+}    // namespace JKRDT
+
+#endif

@@ -1,0 +1,163 @@
+/* jkr/dt: one step of a contact's tangential state (section 2.2): trace
+   the pointers, integrate the twisting angle, clamp to the elastic limits,
+   book the dissipated energy. The equations are in jkr_dt_tangential.h.
+
+   Order within a step (after the drift of velocity Verlet, omega at its
+   half-step value):
+     1. the pointers turn with their particles: n <- Rot(omega dt) n;
+        phi += (omega1 - omega2) . n_c dt, with n_c at the half step
+     2. a contact that breaks books what its springs held and is gone
+     3. displacements beyond their limits are clamped (eqs. 42, A8)
+     4. the loads (eqs. 14, 17, 23, 27) are computed from the clamped state
+   A contact that forms gets n1 = -n_c, n2 = n_c, phi = 0. The force
+   evaluation of a run's setup moves nothing and books nothing.
+
+   Energy: a step that clamps or breaks books, per channel, the difference
+   between the work the loads did (trapezoid over the step, which is what
+   velocity Verlet gives the kinetic energy) and the change of the channel's
+   potential; see step_dissipation(). The state at the start of the step is
+   the stored one, at positions x - v dt.                                    */
+
+#include "pair_jkr_dt.h"
+
+#include "fix_jkr_dt_contacts.h"
+
+#include "atom.h"
+#include "update.h"
+
+#include <cmath>
+
+using namespace LAMMPS_NS;
+using namespace JKRDT;
+using Contacts = FixJKRDTContacts;
+
+static constexpr int CHANNEL_LEDGER[NCHANNEL] = {Contacts::SLIDING, Contacts::ROLLING,
+                                                 Contacts::TWISTING};
+
+/* ----------------------------------------------------------------------
+   stiffnesses and limits of one contact from the pair's constants
+------------------------------------------------------------------------- */
+
+Tangential PairJKRDT::tangential_constants(const Param &P, const NormalScales &S) const
+{
+  Tangential K;
+  K.sliding = P.sliding;
+  K.rolling = P.rolling;
+  K.twisting = P.twisting;
+  K.k_s = P.ks_coef * S.a0;                        // eq. (12)
+  K.zeta_crit = P.zeta_coef * S.a0;                // eq. (36)
+  K.k_r = P.k_r;                                   // eq. (22)
+  K.xi_crit = P.xi_crit;
+  K.k_t = P.kt_coef * S.a0 * S.a0 * S.a0;          // eq. (26)
+  K.phi_crit = JKRDT::phi_crit();                  // eq. (38)
+  return K;
+}
+
+/* ----------------------------------------------------------------------
+   each atom's rotation over the step, owned and ghost; once per step
+------------------------------------------------------------------------- */
+
+void PairJKRDT::spin_rotations()
+{
+  const int nall = atom->nlocal + atom->nghost;
+  if ((int) spin.size() < nall) spin.resize(atom->nmax);
+  double **omega = atom->omega;
+  const double dt = update->dt;
+  for (int i = 0; i < nall; i++) spin[i] = spin_rotation(omega[i], dt);
+}
+
+/* ----------------------------------------------------------------------
+   the stored state of a contact; false if its pointers were never set
+   (a contact that was formed while no channel needed them)
+------------------------------------------------------------------------- */
+
+bool PairJKRDT::read_state(const double *values, ContactState &c) const
+{
+  const auto &C = *fix_contacts;
+  c.n1 = {0.0, 0.0, 0.0};
+  c.n2 = c.n1;
+  c.phi = 0.0;
+  bool set = true;
+  if (C.has_field(Contacts::POINTERS)) {
+    const double *n = values + C.offset(Contacts::POINTERS);
+    c.n1 = vec(n);
+    c.n2 = vec(n + 3);
+    set = dot(c.n1, c.n1) > 0.0;
+  }
+  if (C.has_field(Contacts::TWIST)) c.phi = values[C.offset(Contacts::TWIST)];
+  return set;
+}
+
+void PairJKRDT::write_state(double *values, const ContactState &c) const
+{
+  if (!values) return;
+  const auto &C = *fix_contacts;
+  if (C.has_field(Contacts::POINTERS)) {
+    double *n = values + C.offset(Contacts::POINTERS);
+    store(c.n1, n);
+    store(c.n2, n + 3);
+  }
+  if (C.has_field(Contacts::TWIST)) values[C.offset(Contacts::TWIST)] = c.phi;
+}
+
+/* ----------------------------------------------------------------------
+   advance the tangential state of contact p-q (p = particle 1) by a step;
+   fills the loads to apply (all zero for a contact that breaks)
+------------------------------------------------------------------------- */
+
+void PairJKRDT::tangential_step(int p, int q, const Param &P, const NormalScales &S,
+                                double *state_p, double *state_q, bool formed, bool breaking,
+                                ChannelLoad load[NCHANNEL])
+{
+  double **x = atom->x;
+  double **v = atom->v;
+  double **omega = atom->omega;
+  const double r1 = atom->radius[p], r2 = atom->radius[q];
+  const bool setup = update->setupflag;
+  const double dt = update->dt;
+  const Tangential K = tangential_constants(P, S);
+  const V3 d12 = vec(x[p]) - vec(x[q]);
+  const V3 nc = unit(d12);
+
+  ContactState before;
+  const bool traced = !formed && read_state(state_p ? state_p : state_q, before);
+  ContactState now = before;
+  if (!traced) {
+    now = {-nc, nc, 0.0};    // section 2.2.4: n1(t0) = -n_c(t0), n2 = n_c
+  } else if (!setup) {
+    now.n1 = rotate(spin[p], before.n1);
+    now.n2 = rotate(spin[q], before.n2);
+    if (K.twisting) {
+      // eq. (24): phi += (omega1 - omega2) . n_c dt, n_c at the half step
+      const V3 dv = vec(v[p]) - vec(v[q]);
+      const V3 nc_half = unit(d12 - (0.5 * dt) * dv);
+      now.phi += dt * dot(vec(omega[p]) - vec(omega[q]), nc_half);
+    }
+  }
+
+  const bool book_step = traced && !setup;
+  int clamped = 0;
+  if (!breaking) clamped = clamp_to_elastic_limits(now, nc, r1, r2, S.R, K);
+  if (breaking)
+    for (int ch = 0; ch < NCHANNEL; ch++) load[ch] = {0.0, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+  else
+    tangential_load(now, d12, r1, r2, S.R, K, load);
+
+  if (book_step && (breaking || clamped)) {
+    const V3 dx12 = dt * (vec(v[p]) - vec(v[q]));
+    const V3 dtheta1 = dt * vec(omega[p]), dtheta2 = dt * vec(omega[q]);
+    ChannelLoad prev[NCHANNEL];
+    tangential_load(before, d12 - dx12, r1, r2, S.R, K, prev);
+    const int nlocal = atom->nlocal;
+    for (int ch = 0; ch < NCHANNEL; ch++) {
+      const double w_before = channel_work(prev[ch], dx12, dtheta1, dtheta2);
+      const double w_after = channel_work(load[ch], dx12, dtheta1, dtheta2);
+      book(CHANNEL_LEDGER[ch], step_dissipation(prev[ch].U, w_before, load[ch].U, w_after), p,
+           q, nlocal);
+    }
+  }
+  if (!breaking) {
+    write_state(state_p, now);
+    write_state(state_q, now);
+  }
+}
