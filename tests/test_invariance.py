@@ -1,5 +1,7 @@
 """Contact state survives reneighboring, MPI decomposition, newton settings and
-restarts: the same aggregate collision gives the same trajectory to round-off."""
+restarts: the same aggregate collision gives the same trajectory to round-off.
+Every test runs with the frictionless model and with the frictional one, whose
+contacts also carry the pointers n1, n2 and the twisting angle."""
 
 import subprocess
 import sys
@@ -20,6 +22,14 @@ S = scales(ICE, R)
 STEPS = 4000      # long enough for ~1000 contacts to form, several to break, atoms to migrate
 
 
+MODELS = {"frictionless": "frictionless", "frictional": f"xi_crit {ICE.xi_crit!r}"}
+
+
+@pytest.fixture(scope="module", params=list(MODELS))
+def model(request):
+    return MODELS[request.param]
+
+
 @pytest.fixture(scope="module")
 def scene(tmp_path_factory):
     rng = np.random.default_rng(7)
@@ -30,10 +40,11 @@ def scene(tmp_path_factory):
     return collision.write(c, ICE, d)
 
 
-def run_deck(workdir, data, nproc=1, steps=STEPS, restart=None, extra=()):
+def run_deck(workdir, data, model, nproc=1, steps=STEPS, restart=None, extra=()):
     workdir.mkdir(parents=True, exist_ok=True)
     cmd = [str(BIN / "lmp"), "-in", str(DECK), "-log", "none", "-screen", "none",
            "-var", "file", str(restart or data), "-var", "out", str(workdir),
+           "-var", "model", model,
            "-var", "steps", str(steps), "-var", "every", "500", *extra]
     if restart:
         cmd += ["-var", "read", "read_restart"]
@@ -56,9 +67,9 @@ def scale_error(a, b):
 
 
 @pytest.fixture(scope="module")
-def serial_dir(scene, tmp_path_factory):
+def serial_dir(scene, model, tmp_path_factory):
     d = tmp_path_factory.mktemp("serial")
-    run_deck(d, scene)
+    run_deck(d, scene, model)
     return d
 
 
@@ -83,29 +94,29 @@ def test_collision_forms_contacts_that_obey_eq5(serial_dir):
 
 @pytest.mark.mpi
 @pytest.mark.parametrize("nproc", [2, 4])
-def test_ranks_match_serial(serial, scene, tmp_path, nproc):
-    parallel = run_deck(tmp_path, scene, nproc=nproc)
+def test_ranks_match_serial(serial, scene, model, tmp_path, nproc):
+    parallel = run_deck(tmp_path, scene, model, nproc=nproc)
     dx, dv = scale_error(serial, parallel)
-    print(f"{nproc} ranks vs 1: max |dx| = {dx:.2e} delta_c, max |dv| = {dv:.2e} m/s")
+    print(f"{model}, {nproc} ranks vs 1: max |dx| = {dx:.2e} delta_c, max |dv| = {dv:.2e} m/s")
     # forces sum in another order across ranks; that round-off grows over 4000 steps
     # of a colliding aggregate but stays far below delta_c (the scale of any event)
     assert dx < 1e-6 and dv < 1e-6
 
 
-def test_newton_on_matches_off(serial, scene, tmp_path):
-    on = run_deck(tmp_path, scene, extra=("-var", "newton", "on"))
+def test_newton_on_matches_off(serial, scene, model, tmp_path):
+    on = run_deck(tmp_path, scene, model, extra=("-var", "newton", "on"))
     dx, dv = scale_error(serial, on)
     print(f"newton on vs off: max |dx| = {dx:.2e} delta_c, max |dv| = {dv:.2e} m/s")
     assert dx < 1e-6 and dv < 1e-6
 
 
 @pytest.mark.parametrize("tvis", ["0", "6e-12"])
-def test_restart_continues_exactly(scene, tmp_path, tvis):
+def test_restart_continues_exactly(scene, model, tmp_path, tvis):
     damping = ("-var", "tvis", tvis)
-    straight = run_deck(tmp_path / "straight", scene, extra=damping)
+    straight = run_deck(tmp_path / "straight", scene, model, extra=damping)
     first = tmp_path / "first"
-    run_deck(first, scene, steps=STEPS // 2, extra=damping)
-    cont = run_deck(tmp_path / "second", scene, steps=STEPS // 2,
+    run_deck(first, scene, model, steps=STEPS // 2, extra=damping)
+    cont = run_deck(tmp_path / "second", scene, model, steps=STEPS // 2,
                     restart=first / "final.restart", extra=damping)
     dx, dv = scale_error(straight, cont)
     assert dx == 0.0 and dv == 0.0     # same arithmetic in the same order: bitwise equal

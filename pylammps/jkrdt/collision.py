@@ -17,7 +17,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .aggregates import gyration_radius, random_rotation
-from .datafile import density_for_2d, write_sphere_data
+from .datafile import write_sphere_data
 from .materials import Material, scales
 
 
@@ -99,10 +99,7 @@ def write(collision: Collision, material: Material, directory) -> Path:
     """Write ``collision.data`` and ``collision.json`` (metadata) into ``directory``."""
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
-    density = material.density
-    if collision.meta["dimension"] == 2:
-        density = density_for_2d(density, collision.radius)
-    write_sphere_data(directory / "collision.data", collision.x, collision.radius, density,
+    write_sphere_data(directory / "collision.data", collision.x, collision.radius, material.density,
                       v=collision.v, types=collision.body, margin=20 * collision.radius)
     tmp = directory / "collision.json.tmp"
     tmp.write_text(json.dumps(collision.meta, indent=2, default=float))

@@ -20,8 +20,9 @@ def write_sphere_data(path, x, radius, density, v=None, omega=None, types=None,
     ----------
     x : (N, 3) array, m
     radius : float or (N,) array, m
-    density : float or (N,) array, kg/m^3 (in 2D LAMMPS reads it per area: pass
-        the value that gives the 3D sphere's mass, see ``density_for_2d``)
+    density : float or (N,) array, kg/m^3. read_data gives a sphere the mass
+        4/3 pi r^3 density in 2D runs too (LAMMPS 22 Jul 2025), so 2D grains
+        keep the mass of the 3D grain, as in Wada et al. (2007)
     v, omega : (N, 3) arrays, m/s and rad/s, optional
     types : (N,) int array, optional (all 1)
     margin : box margin around the atoms, m (default 10 radii)
@@ -56,8 +57,3 @@ def write_sphere_data(path, x, radius, density, v=None, omega=None, types=None,
     tmp.replace(path)
     return path
 
-
-def density_for_2d(density: float, radius: float) -> float:
-    """Per-area density that makes LAMMPS (dimension 2) give a disc the mass of
-    a 3D sphere: rho_2d pi r^2 = rho 4/3 pi r^3."""
-    return density * 4.0 / 3.0 * radius
