@@ -56,43 +56,30 @@ inline V3 unit(const V3 &a) { return (1.0 / norm(a)) * a; }
    with): the rotation by the angle |omega| dt about omega (Rodrigues).
    This is eqs. (32)-(33) integrated exactly over the step with omega held
    at its half-step value: the rotational twin of x += v dt. It keeps the
-   scheme time-reversible and second order, and a pointer's length changes
-   only by round-off, which renormalization removes.
+   scheme time-reversible and second order. Turning the pointers directly
+   needs no per-particle orientation, which atom_style sphere does not
+   have; it is the same as eqs. (28)-(29) with n' fixed in the particle.
 ------------------------------------------------------------------------ */
 
-struct Rotation {
-  double m[3][3];
-};
-
-inline Rotation spin_rotation(const double *omega, double dt)
+// n turned by the angle vector w = omega dt:  n + a (w x n) + b w x (w x n),
+// a = sin(t)/t, b = (1 - cos t)/t^2, t = |w| (Rodrigues). Below t = 0.01 the
+// series to t^6 is exact in double precision and needs no sqrt, sin or cos.
+// One Newton step for 1/|n| puts the result back on the unit sphere.
+inline V3 turned(const V3 &n, const V3 &w)
 {
-  Rotation R;
-  const V3 w = dt * vec(omega);
-  const double angle = norm(w);
-  if (angle == 0.0) {
-    for (int a = 0; a < 3; a++)
-      for (int b = 0; b < 3; b++) R.m[a][b] = (a == b) ? 1.0 : 0.0;
-    return R;
+  const double t2 = dot(w, w);
+  double a, b;
+  if (t2 < 1.0e-4) {
+    a = 1.0 - t2 / 6.0 * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0));
+    b = 0.5 * (1.0 - t2 / 12.0 * (1.0 - t2 / 30.0 * (1.0 - t2 / 56.0)));
+  } else {
+    const double t = std::sqrt(t2);
+    a = std::sin(t) / t;
+    b = (1.0 - std::cos(t)) / t2;
   }
-  const V3 k = (1.0 / angle) * w;
-  const double c = std::cos(angle), s = std::sin(angle), t = 1.0 - c;
-  const double kv[3] = {k.x, k.y, k.z};
-  for (int a = 0; a < 3; a++)
-    for (int b = 0; b < 3; b++) R.m[a][b] = t * kv[a] * kv[b] + ((a == b) ? c : 0.0);
-  R.m[0][1] -= s * k.z;
-  R.m[0][2] += s * k.y;
-  R.m[1][0] += s * k.z;
-  R.m[1][2] -= s * k.x;
-  R.m[2][0] -= s * k.y;
-  R.m[2][1] += s * k.x;
-  return R;
-}
-
-inline V3 rotate(const Rotation &R, const V3 &v)
-{
-  return unit({R.m[0][0] * v.x + R.m[0][1] * v.y + R.m[0][2] * v.z,
-               R.m[1][0] * v.x + R.m[1][1] * v.y + R.m[1][2] * v.z,
-               R.m[2][0] * v.x + R.m[2][1] * v.y + R.m[2][2] * v.z});
+  const V3 wn = cross(w, n);
+  const V3 r = n + a * wn + b * cross(w, wn);
+  return (1.5 - 0.5 * dot(r, r)) * r;
 }
 
 /* ---------------------------------------------------------------------
@@ -142,14 +129,13 @@ struct ChannelLoad {
   V3 M1, M2;   // torques on particles 1 and 2, eqs. (17), (23), (27)
 };
 
-// d12 = x1 - x2
-inline void tangential_load(const ContactState &c, const V3 &d12, double r1, double r2, double R,
-                            const Tangential &K, ChannelLoad load[NCHANNEL])
+// nc = (x1 - x2) / dist, eq. (9)
+inline void tangential_load(const ContactState &c, const V3 &nc, double dist, double r1, double r2,
+                            double R, const Tangential &K, ChannelLoad load[NCHANNEL])
 {
-  const double dist = norm(d12);
-  const V3 nc = (1.0 / dist) * d12;    // eq. (9)
   const V3 zero = {0.0, 0.0, 0.0};
-  for (int ch = 0; ch < NCHANNEL; ch++) load[ch] = {0.0, zero, zero, zero};
+  if (!(K.sliding && K.rolling && K.twisting))
+    for (int ch = 0; ch < NCHANNEL; ch++) load[ch] = {0.0, zero, zero, zero};
 
   if (K.sliding) {
     const V3 zeta0 = sliding_zeta0(c, nc, r1, r2);
@@ -164,12 +150,14 @@ inline void tangential_load(const ContactState &c, const V3 &d12, double r1, dou
     const V3 xi = rolling_xi(c, R);
     ChannelLoad &r = load[ROLL];
     r.U = 0.5 * K.k_r * dot(xi, xi);                                     // eq. (21)
+    r.F1 = zero;
     r.M1 = (-R * K.k_r) * cross(c.n1, xi);                               // eq. (23)
     r.M2 = (-R * K.k_r) * cross(c.n2, xi);
   }
   if (K.twisting) {
     ChannelLoad &t = load[TWIST];
     t.U = 0.5 * K.k_t * c.phi * c.phi;                                   // eq. (25)
+    t.F1 = zero;
     t.M1 = (-K.k_t * c.phi) * nc;                                        // eq. (27)
     t.M2 = -t.M1;
   }
@@ -221,8 +209,9 @@ inline int clamp_to_elastic_limits(ContactState &c, const V3 &nc, double r1, dou
   int clamped = 0;
   if (K.sliding) {
     const V3 zeta = tangential_part(sliding_zeta0(c, nc, r1, r2), nc);
-    const double z = norm(zeta);
-    if (z > K.zeta_crit) {
+    const double z2 = dot(zeta, zeta);
+    if (z2 > K.zeta_crit * K.zeta_crit) {
+      const double z = std::sqrt(z2);
       const V3 shift = ((1.0 - K.zeta_crit / z) / (r1 + r2)) * zeta;    // dzeta / (r1 + r2)
       c.n1 = corrected_pointer(c.n1, shift);                            // eq. (42)
       c.n2 = corrected_pointer(c.n2, -shift);
@@ -231,8 +220,9 @@ inline int clamp_to_elastic_limits(ContactState &c, const V3 &nc, double r1, dou
   }
   if (K.rolling) {
     const V3 xi = rolling_xi(c, R);
-    const double x = norm(xi);
-    if (x > K.xi_crit) {
+    const double x2 = dot(xi, xi);
+    if (x2 > K.xi_crit * K.xi_crit) {
+      const double x = std::sqrt(x2);
       const V3 dxi = (1.0 - K.xi_crit / x) * xi;
       c.n1 = corrected_pointer(c.n1, (1.0 / r1) * dxi);                 // eq. (42) for rolling
       c.n2 = corrected_pointer(c.n2, (1.0 / r2) * dxi);

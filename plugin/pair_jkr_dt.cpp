@@ -212,8 +212,10 @@ void PairJKRDT::compute(int eflag, int vflag)
     memory->create(visited, nmax_visited, "jkr/dt:visited");
   }
   std::fill(visited, visited + nlocal, 0);
-  if (any_tangential && !setup) spin_rotations();
 
+  JKRDT::NormalScales S{};
+  const Param *last_param = nullptr;
+  double last_r1 = -1.0, last_r2 = -1.0;
   double upot = 0.0;
   double utan[JKRDT::NCHANNEL] = {0.0, 0.0, 0.0};
   JKRDT::ChannelLoad load[JKRDT::NCHANNEL];
@@ -255,8 +257,13 @@ void PairJKRDT::compute(int eflag, int vflag)
                    tag[p], tag[q], r);
 
       const Param &P = par(type[p], type[q]);
-      const JKRDT::NormalScales S =
-          JKRDT::normal_scales(radius[p], radius[q], P.gamma, P.a0_coef);
+      // the scales depend on the radii and the type pair only: reuse the last ones
+      if (&P != last_param || radius[p] != last_r1 || radius[q] != last_r2) {
+        S = JKRDT::normal_scales(radius[p], radius[q], P.gamma, P.a0_coef);
+        last_param = &P;
+        last_r1 = radius[p];
+        last_r2 = radius[q];
+      }
 
       double *state_p = (p_own && C.dnum) ? C.contact_values(p, kp) : nullptr;
       double *state_q = (q_own && C.dnum) ? C.contact_values(q, kq) : nullptr;
@@ -274,7 +281,9 @@ void PairJKRDT::compute(int eflag, int vflag)
             book(Contacts::DAMPING, 0.5 * dt * fd_prev * vn, p, q, nlocal);
           }
         }
-        if (P.tangential()) tangential_step(p, q, P, S, state_p, state_q, false, true, load);
+        if (P.tangential())
+          tangential_step(p, q, P, S, state_p, state_q, false, true,
+                          rinv * JKRDT::V3{delx, dely, delz}, r, load);
         if (p_own) C.remove(p, kp);
         if (q_own) C.remove(q, kq);
         continue;
@@ -309,15 +318,26 @@ void PairJKRDT::compute(int eflag, int vflag)
       // force on p: normal (eq. 5 and A.5) plus sliding (eq. 14); torques eqs. (17), (23), (27)
       const double fpair = fmag * rinv;
       JKRDT::V3 fp = {delx * fpair, dely * fpair, delz * fpair};
-      JKRDT::V3 mp = {0.0, 0.0, 0.0}, mq = mp;
       double u_t = 0.0;
       if (P.tangential()) {
-        tangential_step(p, q, P, S, state_p, state_q, formed, false, load);
+        tangential_step(p, q, P, S, state_p, state_q, formed, false,
+                        rinv * JKRDT::V3{delx, dely, delz}, r, load);
+        JKRDT::V3 mp = {0.0, 0.0, 0.0}, mq = mp;
         for (int ch = 0; ch < JKRDT::NCHANNEL; ch++) {
           fp = fp + load[ch].F1;
           mp = mp + load[ch].M1;
           mq = mq + load[ch].M2;
           u_t += load[ch].U;
+        }
+        if (p_own) {
+          torque[p][0] += mp.x;
+          torque[p][1] += mp.y;
+          torque[p][2] += mp.z;
+        }
+        if (q_own) {
+          torque[q][0] += mq.x;
+          torque[q][1] += mq.y;
+          torque[q][2] += mq.z;
         }
       }
       const double share = 0.5 * ((p_own ? 1.0 : 0.0) + (q_own ? 1.0 : 0.0));
@@ -325,18 +345,12 @@ void PairJKRDT::compute(int eflag, int vflag)
         f[p][0] += fp.x;
         f[p][1] += fp.y;
         f[p][2] += fp.z;
-        torque[p][0] += mp.x;
-        torque[p][1] += mp.y;
-        torque[p][2] += mp.z;
         visited[p]++;
       }
       if (q_own) {
         f[q][0] -= fp.x;
         f[q][1] -= fp.y;
         f[q][2] -= fp.z;
-        torque[q][0] += mq.x;
-        torque[q][1] += mq.y;
-        torque[q][2] += mq.z;
         visited[q]++;
       }
       if (eflag) {

@@ -4,7 +4,7 @@
 
    Order within a step (after the drift of velocity Verlet, omega at its
    half-step value):
-     1. the pointers turn with their particles: n <- Rot(omega dt) n;
+     1. the pointers turn with their particles: n <- turned(n, omega dt);
         phi += (omega1 - omega2) . n_c dt, with n_c at the half step
      2. a contact that breaks books what its springs held and is gone
      3. displacements beyond their limits are clamped (eqs. 42, A8)
@@ -54,19 +54,6 @@ Tangential PairJKRDT::tangential_constants(const Param &P, const NormalScales &S
 }
 
 /* ----------------------------------------------------------------------
-   each atom's rotation over the step, owned and ghost; once per step
-------------------------------------------------------------------------- */
-
-void PairJKRDT::spin_rotations()
-{
-  const int nall = atom->nlocal + atom->nghost;
-  if ((int) spin.size() < nall) spin.resize(atom->nmax);
-  double **omega = atom->omega;
-  const double dt = update->dt;
-  for (int i = 0; i < nall; i++) spin[i] = spin_rotation(omega[i], dt);
-}
-
-/* ----------------------------------------------------------------------
    the stored state of a contact; false if its pointers were never set
    (a contact that was formed while no channel needed them)
 ------------------------------------------------------------------------- */
@@ -107,7 +94,7 @@ void PairJKRDT::write_state(double *values, const ContactState &c) const
 
 void PairJKRDT::tangential_step(int p, int q, const Param &P, const NormalScales &S,
                                 double *state_p, double *state_q, bool formed, bool breaking,
-                                ChannelLoad load[NCHANNEL])
+                                const V3 &nc, double dist, ChannelLoad load[NCHANNEL])
 {
   double **x = atom->x;
   double **v = atom->v;
@@ -117,7 +104,6 @@ void PairJKRDT::tangential_step(int p, int q, const Param &P, const NormalScales
   const double dt = update->dt;
   const Tangential K = tangential_constants(P, S);
   const V3 d12 = vec(x[p]) - vec(x[q]);
-  const V3 nc = unit(d12);
 
   ContactState before;
   const bool traced = !formed && read_state(state_p ? state_p : state_q, before);
@@ -125,12 +111,14 @@ void PairJKRDT::tangential_step(int p, int q, const Param &P, const NormalScales
   if (!traced) {
     now = {-nc, nc, 0.0};    // section 2.2.4: n1(t0) = -n_c(t0), n2 = n_c
   } else if (!setup) {
-    now.n1 = rotate(spin[p], before.n1);
-    now.n2 = rotate(spin[q], before.n2);
+    now.n1 = turned(before.n1, dt * vec(omega[p]));
+    now.n2 = turned(before.n2, dt * vec(omega[q]));
     if (K.twisting) {
-      // eq. (24): phi += (omega1 - omega2) . n_c dt, n_c at the half step
-      const V3 dv = vec(v[p]) - vec(v[q]);
-      const V3 nc_half = unit(d12 - (0.5 * dt) * dv);
+      // eq. (24): phi += (omega1 - omega2) . n_c dt, n_c at the half step:
+      // (d12 - h) / |d12 - h| with h = (v1 - v2) dt/2, to first order in h / dist
+      // (the error, (h / dist)^2 of one increment, is third order in dt)
+      const V3 h = (0.5 * dt) * (vec(v[p]) - vec(v[q]));
+      const V3 nc_half = ((1.0 + dot(nc, h) / dist) / dist) * (d12 - h);
       now.phi += dt * dot(vec(omega[p]) - vec(omega[q]), nc_half);
     }
   }
@@ -141,13 +129,15 @@ void PairJKRDT::tangential_step(int p, int q, const Param &P, const NormalScales
   if (breaking)
     for (int ch = 0; ch < NCHANNEL; ch++) load[ch] = {0.0, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
   else
-    tangential_load(now, d12, r1, r2, S.R, K, load);
+    tangential_load(now, nc, dist, r1, r2, S.R, K, load);
 
   if (book_step && (breaking || clamped)) {
     const V3 dx12 = dt * (vec(v[p]) - vec(v[q]));
     const V3 dtheta1 = dt * vec(omega[p]), dtheta2 = dt * vec(omega[q]);
     ChannelLoad prev[NCHANNEL];
-    tangential_load(before, d12 - dx12, r1, r2, S.R, K, prev);
+    const V3 d12_before = d12 - dx12;
+    const double dist_before = norm(d12_before);
+    tangential_load(before, (1.0 / dist_before) * d12_before, dist_before, r1, r2, S.R, K, prev);
     const int nlocal = atom->nlocal;
     for (int ch = 0; ch < NCHANNEL; ch++) {
       const double w_before = channel_work(prev[ch], dx12, dtheta1, dtheta2);
