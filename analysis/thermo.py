@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 LEDGER = ["c_p[5]", "c_p[6]", "c_p[7]", "c_p[8]", "c_p[9]"]   # dissipated, by channel
+CHANNELS = ["events", "damping", "sliding", "rolling", "twisting"]  # the order of LEDGER
 
 
 def read_thermo(log) -> dict[str, np.ndarray]:
@@ -36,8 +37,12 @@ def read_thermo(log) -> dict[str, np.ndarray]:
 
 
 def energy_budget(thermo: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-    """Kinetic (with rotation), potential, dissipated and total energy over the run."""
+    """Kinetic (with rotation), potential, dissipated (in all and by channel:
+    'events' = contact formation and breaking, 'damping', 'sliding', 'rolling',
+    'twisting') and total energy over the run."""
     kinetic = thermo["KinEng"] + thermo["c_erot"]
     dissipated = sum(thermo[c] for c in LEDGER)
-    return dict(kinetic=kinetic, potential=thermo["PotEng"], dissipated=dissipated,
-                total=kinetic + thermo["PotEng"] + dissipated)
+    budget = dict(kinetic=kinetic, potential=thermo["PotEng"], dissipated=dissipated,
+                  total=kinetic + thermo["PotEng"] + dissipated)
+    budget.update({name: thermo[c] for name, c in zip(CHANNELS, LEDGER)})
+    return budget

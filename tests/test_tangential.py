@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from conftest import ICE_SCALES as S, R_GRAIN, ledger, two_grain_scene
-from jkrdt.materials import ICE
+from jkrdt.materials import ICE, QUARTZ, scales
 from jkrdt.session import start_lammps
 
 XI_CRIT = ICE.xi_crit
@@ -61,6 +61,12 @@ def test_constants_match_table3_and_the_3d_paper():
     assert K_S * ZETA_CRIT == pytest.approx(F_FRIC, rel=1e-12)
     assert K_S * ZETA_CRIT * math.pi * S.R == pytest.approx(G * S.a0 ** 2 * S.R / 4, rel=1e-12)
     assert K_T * PHI_CRIT * math.pi / 2 == pytest.approx(G * S.a0 ** 3 / 12, rel=1e-12)
+    # Table 3, quartz at xi_crit = 2 Angstrom: E_roll = 28.7 F_c delta_c; the Python scales agree
+    q = scales(QUARTZ, R_GRAIN)
+    assert q.E_roll / (q.F_c * q.delta_c) == pytest.approx(28.7, rel=0.01)
+    for name, value in [("k_s", K_S), ("zeta_crit", ZETA_CRIT), ("F_fric", F_FRIC), ("k_r", K_R),
+                        ("k_t", K_T), ("M_fric", M_FRIC)]:
+        assert getattr(S, name) == pytest.approx(value, rel=1e-12), name
 
 
 @pytest.mark.parametrize("kr_scale", [1.0, 0.5])

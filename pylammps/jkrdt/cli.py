@@ -46,7 +46,7 @@ def demo(args) -> int:
     from jkrdt.analysis.dumps import last_local_snapshot
     from jkrdt.analysis.outcome import fragments, outcome
     from jkrdt.analysis.plots import snapshot
-    from jkrdt.analysis.thermo import energy_budget, read_thermo
+    from jkrdt.analysis.thermo import CHANNELS, energy_budget, read_thermo
 
     out = Path(args.out).resolve()
     out.mkdir(parents=True, exist_ok=True)
@@ -63,9 +63,10 @@ def demo(args) -> int:
     print(f"built 2 BPCA of {args.n} grains and set up the collision in {time.time() - t0:.1f} s")
 
     dt = 0.014 * s.t_c
+    model = "frictionless" if args.model == "frictionless" else f"xi_crit {mat.xi_crit!r}"
     t0 = time.time()
     run_lammps(find_deck(), out, dict(file=data, out=out, steps=args.steps, every=args.steps // 20,
-                                      dt=dt, model="frictionless"), nproc=args.np)
+                                      dt=dt, model=model), nproc=args.np)
     wall = time.time() - t0
     print(f"ran {args.steps} steps of {2 * args.n} grains in {wall:.1f} s on {args.np} rank(s)")
 
@@ -78,14 +79,17 @@ def demo(args) -> int:
     error = float(np.abs(budget["total"] - budget["total"][0]).max() / e_imp)
     pictures = snapshot(out / "outcome", final[:, 1:4], fragments(len(final), pairs),
                         f"ice BPCA {args.n}+{args.n}, v = {args.v} m/s, B_off = {args.b_off}, "
-                        f"frictionless")
-    summary = dict(dataclass=result.__dict__, E_imp=e_imp, energy_error=error,
-                   dissipated_fraction=float(budget["dissipated"][-1] / e_imp), wall_seconds=wall)
+                        f"{args.model} model")
+    channels = {name: float(budget[name][-1] / e_imp) for name in CHANNELS}
+    summary = dict(dataclass=result.__dict__, E_imp=e_imp, energy_error=error, model=args.model,
+                   dissipated_fraction=float(budget["dissipated"][-1] / e_imp),
+                   dissipated_by_channel=channels, wall_seconds=wall)
     (out / "summary.json").write_text(json.dumps(summary, indent=2, default=float))
     print()
     print(result.summary())
     print(f"impact energy E_imp         {e_imp:.3e} J")
-    print(f"dissipated / E_imp          {summary['dissipated_fraction']:.3f}")
+    print(f"dissipated / E_imp          {summary['dissipated_fraction']:.3f}  ("
+          + ", ".join(f"{k} {v:.3f}" for k, v in channels.items()) + ")")
     print(f"max |dE| / E_imp            {error:.2e}")
     print(f"picture                     {pictures[0]}")
     return 0
@@ -100,6 +104,9 @@ def main(argv=None) -> int:
     d.add_argument("--b-off", type=float, default=0.3, help="impact parameter B_off")
     d.add_argument("--steps", type=int, default=40000)
     d.add_argument("--np", type=int, default=1, help="MPI ranks")
+    d.add_argument("--model", choices=["frictional", "frictionless"], default="frictional",
+                   help="Wada et al. (2007) with sliding, rolling, twisting (xi_crit = 8 A), "
+                        "or the frictionless model of the 3D BPCA paper")
     d.add_argument("--seed", type=int, default=1)
     d.add_argument("--out", default="runs/demo")
     args = parser.parse_args(argv)

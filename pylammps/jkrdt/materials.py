@@ -14,8 +14,16 @@ F_c        3 pi gamma R                                   below (5)
 v0, t_c    sqrt(F_c delta_c / m), delta_c / v0            eqs. (48)-(49)
 E_roll     12 pi^2 gamma R xi_crit                        eq. (44), (A.9)
 E_break    (4/45 + 4/5 6^(1/3)) F_c delta_c ~ 1.54 F_c delta_c   eq. (45), (A.7)
+k_s        8 a0 G*,  G* = G / (2 (2 - nu))                eqs. (12)-(13)
+zeta_crit  (2 - nu) a0 / (16 pi)                          eq. (36)
+F_fric     k_s zeta_crit = (G/2) a0^2 / (2 pi)            eq. (35)
+k_r        4 F_c / R                                      eq. (22)
+k_t        16/3 (G/2) a0^3                                eq. (26)
+M_fric     k_t / (16 pi) = (G/2) a0^3 / (3 pi)            eqs. (37)-(38)
+E_slide    k_s zeta_crit pi R = G a0^2 R / 4              (A.11)
+E_twist    k_t phi_crit pi/2 = G a0^3 / 12                (A.13)
 =========  ============================================  ===========
-with R = r/2 and E* = E / (2 (1 - nu^2)).
+with R = r/2, E* = E / (2 (1 - nu^2)) and G the shear modulus.
 """
 
 from __future__ import annotations
@@ -100,6 +108,14 @@ class Scales:
     t_c: float
     E_roll: float | None
     E_break: float
+    k_s: float
+    zeta_crit: float
+    F_fric: float
+    k_r: float
+    k_t: float
+    M_fric: float
+    E_slide: float
+    E_twist: float
 
 
 E_BREAK_RATIO = 4.0 / 45.0 + 0.8 * 6.0 ** (1.0 / 3.0)   # E_break / (F_c delta_c), eq. (A.7)
@@ -118,6 +134,13 @@ def scales(mat: Material, r: float) -> Scales:
     mass = 4.0 / 3.0 * math.pi * r ** 3 * mat.density
     v0 = math.sqrt(F_c * delta_c / mass)
     E_roll = None if mat.xi_crit is None else 12.0 * math.pi ** 2 * mat.gamma * R * mat.xi_crit
+    G = mat.shear_modulus
+    k_s = 8.0 * a0 * G / (2.0 * (2.0 - mat.nu))
+    zeta_crit = (2.0 - mat.nu) * a0 / (16.0 * math.pi)
+    k_t = 16.0 / 3.0 * (G / 2.0) * a0 ** 3
     return Scales(r=r, R=R, Estar=Estar, a0=a0, delta0=delta0, delta_c=delta_c, F_c=F_c,
                   mass=mass, v0=v0, t_c=delta_c / v0, E_roll=E_roll,
-                  E_break=E_BREAK_RATIO * F_c * delta_c)
+                  E_break=E_BREAK_RATIO * F_c * delta_c,
+                  k_s=k_s, zeta_crit=zeta_crit, F_fric=k_s * zeta_crit, k_r=4.0 * F_c / R,
+                  k_t=k_t, M_fric=k_t / (16.0 * math.pi),
+                  E_slide=k_s * zeta_crit * math.pi * R, E_twist=k_t / (16.0 * math.pi) * math.pi / 2)
