@@ -28,51 +28,95 @@ def random_directions(rng: np.random.Generator, n: int, dim: int) -> np.ndarray:
     return v / np.linalg.norm(v, axis=1, keepdims=True)
 
 
+class _GrowingSet:
+    """Positions of a growing cluster with neighbour queries: a kd-tree rebuilt
+    every 256 grains, plus the grains added since."""
+
+    def __init__(self, capacity: int):
+        self.x = np.zeros((capacity, 3))
+        self.n = 0
+        self.tree, self.n_tree = None, 0
+
+    def add(self, p):
+        self.x[self.n] = p
+        self.n += 1
+        if self.n >= self.n_tree + 256:
+            self.tree, self.n_tree = cKDTree(self.x[:self.n]), self.n
+
+    def near(self, points: np.ndarray, distance: float) -> np.ndarray:
+        """Indices of the grains within ``distance`` of any of ``points``; while the
+        cluster is small, all of them (the caller tests exactly)."""
+        if self.n < 2048:
+            return np.arange(self.n)
+        found = []
+        if self.tree is not None:
+            hits = self.tree.query_ball_point(points, distance)
+            found = [np.concatenate([np.asarray(h, dtype=int) for h in hits])]
+        recent = self.x[self.n_tree:self.n]
+        d2 = ((recent[None, :, :] - points[:, None, :]) ** 2).sum(axis=2)
+        found.append(self.n_tree + np.flatnonzero((d2 < distance ** 2).any(axis=0)))
+        return np.unique(np.concatenate(found))
+
+
 def bpca(n: int, radius: float, delta0: float, rng: np.random.Generator, dim: int = 3,
          max_tries: int = 10000) -> np.ndarray:
     """Positions (n, 3) of a BPCA of ``n`` grains of ``radius``, centred on its centre of mass.
 
     Each new grain comes from a random direction along a straight line with a
-    random offset inside the cluster's cross-section and sticks where it first
-    touches; it is then pulled onto the bond length 2 r - delta0.
+    random offset inside a disc (3D) or segment (2D) that covers the cluster,
+    and sticks where it first touches; it is then pulled onto the bond length
+    2 r - delta0. A grain that would touch a second one there is thrown again.
+    Beyond 2048 grains, grains near the line are found with a kd-tree, so a
+    grain costs about O(log N) plus its path through the cluster, not O(N).
     """
     if n < 1:
         raise ValueError("an aggregate needs n >= 1 grains")
     _check(dim, radius, delta0)
     contact = 2.0 * radius
     bond = contact - delta0
-    x = np.zeros((n, 3))
+    grains = _GrowingSet(n)
+    grains.add(np.zeros(3))
+    total = np.zeros(3)          # sum of positions, for the centre of mass
+    reach = 0.0                  # bound on the distance of any grain from the centre
     for k in range(1, n):
-        placed = False
+        centre = total / k
+        span = reach + contact
         for _ in range(max_tries):
-            centre = x[:k].mean(axis=0)
-            reach = np.sqrt(((x[:k] - centre) ** 2).sum(axis=1).max()) + contact
             u = random_directions(rng, 1, dim)[0]
-            # offset uniform over the disc (3D) or segment (2D) across the approach line
             w = random_directions(rng, 1, dim)[0]
             w -= (w @ u) * u
             w /= np.linalg.norm(w)
-            spread = reach * (np.sqrt(rng.random()) if dim == 3 else 2 * rng.random() - 1)
-            start = centre - 2.0 * reach * u + spread * w
-            # first grain the ray start + t u touches: |start + t u - x_i| = 2r
-            rel = start - x[:k]
+            spread = span * (np.sqrt(rng.random()) if dim == 3 else 2 * rng.random() - 1)
+            start = centre - span * u + spread * w
+            # grains within 2r of the path: near samples every 2r along it (cover 2.24 r)
+            samples = start + np.outer(np.arange(0.0, 2 * span + contact, contact), u)
+            cand = grains.near(samples, 1.125 * contact)
+            if cand.size == 0:
+                continue
+            rel = start - grains.x[cand]
             b = rel @ u
             disc = b * b - ((rel ** 2).sum(axis=1) - contact ** 2)
-            hits = np.flatnonzero(disc >= 0)
-            if hits.size == 0:
+            hit = disc >= 0
+            if not hit.any():
                 continue
-            t = -b[hits] - np.sqrt(disc[hits])
-            target = hits[np.argmin(t)]
+            t = -b[hit] - np.sqrt(disc[hit])
+            target = cand[hit][np.argmin(t)]
             touch = start + t.min() * u
-            new = x[target] + (touch - x[target]) * (bond / contact)
-            gaps = np.sqrt(((x[:k] - new) ** 2).sum(axis=1))
-            gaps[target] = np.inf
-            if gaps.min() > contact:
-                x[k] = new
-                placed = True
+            new = grains.x[target] + (touch - grains.x[target]) * (bond / contact)
+            near = grains.near(new[None, :], contact)
+            gaps = np.linalg.norm(grains.x[near] - new, axis=1)
+            if np.array_equal(near[gaps <= contact], [target]):
                 break
-        if not placed:
+        else:
             raise RuntimeError(f"BPCA: could not place grain {k} in {max_tries} tries")
+        grains.add(new)
+        total += new
+        moved = total / (k + 1)
+        # the old grains are at most reach + |shift of the centre| from the new centre
+        reach = max(reach + np.linalg.norm(moved - centre), np.linalg.norm(new - moved))
+        if k % 256 == 0:
+            reach = float(np.sqrt(((grains.x[:k + 1] - moved) ** 2).sum(axis=1).max()))
+    x = grains.x[:n]
     return x - x.mean(axis=0)
 
 
