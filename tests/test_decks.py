@@ -45,3 +45,15 @@ def test_aggregate_decks_conserve_energy(tmp_path, deck, nproc):
     assert abs(budget["total"] - budget["total"][0]).max() < 1e-5 * e_imp
     assert budget["rolling"][-1] > 0.0                  # the frictional model acts
     assert (out / "final.restart").exists() and (out / "atoms.dump").exists()
+
+
+def test_cli_setup_then_run_under_two_ranks(tmp_path):
+    scene = tmp_path / "scene"
+    jkrdt = str(BIN / "jkrdt")
+    subprocess.run([jkrdt, "setup", "--kind", "bcca", "--dim", "2", "--n-tar", "32", "--n-pro",
+                    "32", "--v", "8", "--seed", "3", "--out", str(scene)], check=True, timeout=120)
+    subprocess.run([jkrdt, "run", str(scene), "--steps", "2000", "--np", "2"], cwd=ROOT,
+                   check=True, timeout=300)
+    budget = energy_budget(read_thermo(scene / "log.lammps"))
+    assert abs(budget["total"] - budget["total"][0]).max() < 1e-5 * budget["kinetic"][0]
+    assert (scene / "final.restart").exists()
