@@ -53,8 +53,7 @@ const char *const PairJKRDT::FIX_ID = "JKR_DT_CONTACTS";
 /* ---------------------------------------------------------------------- */
 
 PairJKRDT::PairJKRDT(LAMMPS *lmp) :
-    Pair(lmp), fix_contacts(nullptr), visited(nullptr), nmax_visited(0), nstride(0),
-    any_tangential(false)
+    Pair(lmp), fix_contacts(nullptr), visited(nullptr), nmax_visited(0), nstride(0)
 {
   single_enable = 0;
   restartinfo = 1;
@@ -99,12 +98,10 @@ void PairJKRDT::init_style()
 
   find_max_radii();
   double cutmax = 0.0;
-  any_tangential = false;
   for (int i = 1; i <= atom->ntypes; i++)
     for (int j = i; j <= atom->ntypes; j++) {
       param[i * nstride + j] = resolve(i, j);
       cutmax = std::max(cutmax, par(i, j).cut);
-      any_tangential = any_tangential || par(i, j).tangential();
     }
   check_periodic_images(cutmax);
 
@@ -282,8 +279,8 @@ void PairJKRDT::compute(int eflag, int vflag)
           }
         }
         if (P.tangential())
-          tangential_step(p, q, P, S, state_p, state_q, false, true,
-                          rinv * JKRDT::V3{delx, dely, delz}, r, load);
+          tangential_step(p, q, P, S, state_p, state_q, false, true, {delx, dely, delz}, r,
+                          load);
         if (p_own) C.remove(p, kp);
         if (q_own) C.remove(q, kq);
         continue;
@@ -320,8 +317,8 @@ void PairJKRDT::compute(int eflag, int vflag)
       JKRDT::V3 fp = {delx * fpair, dely * fpair, delz * fpair};
       double u_t = 0.0;
       if (P.tangential()) {
-        tangential_step(p, q, P, S, state_p, state_q, formed, false,
-                        rinv * JKRDT::V3{delx, dely, delz}, r, load);
+        tangential_step(p, q, P, S, state_p, state_q, formed, false, {delx, dely, delz}, r,
+                        load);
         JKRDT::V3 mp = {0.0, 0.0, 0.0}, mq = mp;
         for (int ch = 0; ch < JKRDT::NCHANNEL; ch++) {
           fp = fp + load[ch].F1;

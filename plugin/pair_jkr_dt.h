@@ -91,8 +91,6 @@ class PairJKRDT : public Pair {
   const Input &in(int i, int j) const { return input[i * nstride + j]; }
   const Param &par(int i, int j) const { return param[i * nstride + j]; }
 
-  bool any_tangential;
-
   void allocate();
   Param resolve(int i, int j) const;
   JKRDT::Tangential tangential_constants(const Param &P, const JKRDT::NormalScales &S) const;
@@ -100,7 +98,7 @@ class PairJKRDT : public Pair {
   void write_state(double *values, const JKRDT::ContactState &c) const;
   void tangential_step(int p, int q, const Param &P, const JKRDT::NormalScales &S,
                        double *state_p, double *state_q, bool formed, bool breaking,
-                       const JKRDT::V3 &nc, double dist, JKRDT::ChannelLoad load[JKRDT::NCHANNEL]);
+                       const JKRDT::V3 &d12, double dist, JKRDT::ChannelLoad load[JKRDT::NCHANNEL]);
   int layout_mask() const;
   void find_max_radii();
   void check_periodic_images(double cutmax);

@@ -89,21 +89,21 @@ void PairJKRDT::write_state(double *values, const ContactState &c) const
 
 /* ----------------------------------------------------------------------
    advance the tangential state of contact p-q (p = particle 1) by a step;
-   fills the loads to apply (all zero for a contact that breaks)
+   d12 = x1 - x2, dist = |d12|; fills the loads to apply (all zero for a
+   contact that breaks)
 ------------------------------------------------------------------------- */
 
 void PairJKRDT::tangential_step(int p, int q, const Param &P, const NormalScales &S,
                                 double *state_p, double *state_q, bool formed, bool breaking,
-                                const V3 &nc, double dist, ChannelLoad load[NCHANNEL])
+                                const V3 &d12, double dist, ChannelLoad load[NCHANNEL])
 {
-  double **x = atom->x;
   double **v = atom->v;
   double **omega = atom->omega;
   const double r1 = atom->radius[p], r2 = atom->radius[q];
   const bool setup = update->setupflag;
   const double dt = update->dt;
   const Tangential K = tangential_constants(P, S);
-  const V3 d12 = vec(x[p]) - vec(x[q]);
+  const V3 nc = (1.0 / dist) * d12;    // eq. (9)
 
   ContactState before;
   const bool traced = !formed && read_state(state_p ? state_p : state_q, before);
