@@ -24,12 +24,15 @@ GOOD_COEFF = "pair_coeff * * gamma 0.1 E 7e9 nu 0.25 frictionless"
 
 
 def run_deck(style="sphere", comm="comm_modify vel yes", coeff=GOOD_COEFF,
-             diameter="set type 1 diameter 2e-7", boundary="f f f", tail="run 0"):
+             diameter="set type 1 diameter 2e-7", boundary="f f f", tail="run 0", check=None):
+    """Run the two-grain deck with ``tail``; ``check(lmp)`` inspects the result."""
     lmp = start_lammps()
     try:
         lmp.commands_string(BASE.format(style=style, comm=comm, coeff=coeff,
                                         diameter=diameter, boundary=boundary))
         lmp.commands_string(tail)
+        if check:
+            check(lmp)
     finally:
         lmp.close()
 
@@ -118,21 +121,16 @@ def test_minimize_is_refused():
 def test_switching_friction_on_mid_run_starts_the_pointers_at_the_contact():
     # contacts formed while the frictionless model stored no pointers get
     # n1 = -n_c, n2 = n_c when friction comes on: zero displacement, no jump
-    lmp = start_lammps()
-    try:
-        lmp.commands_string(BASE.format(style="sphere", comm="comm_modify vel yes",
-                                        coeff=GOOD_COEFF, diameter="set type 1 diameter 2e-7",
-                                        boundary="f f f"))
-        lmp.commands_string("""
-            fix integrate all nve/sphere
-            compute bonds all jkr/dt/contacts
-            timestep 1e-12
-            run 10
-            pair_coeff * * gamma 0.1 E 7e9 nu 0.25 xi_crit 8e-10
-            run 0
-        """)
+    def zero_displacements(lmp):
         rows = lmp.numpy.extract_compute("bonds", 2, 2)
         assert rows.shape == (1, 8)
         assert rows[0, 5] == rows[0, 6] == rows[0, 7] == 0.0
-    finally:
-        lmp.close()
+
+    run_deck(tail="""
+        fix integrate all nve/sphere
+        compute bonds all jkr/dt/contacts
+        timestep 1e-12
+        run 10
+        pair_coeff * * gamma 0.1 E 7e9 nu 0.25 xi_crit 8e-10
+        run 0
+    """, check=zero_displacements)
