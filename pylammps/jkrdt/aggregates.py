@@ -28,6 +28,10 @@ def random_directions(rng: np.random.Generator, n: int, dim: int) -> np.ndarray:
     return v / np.linalg.norm(v, axis=1, keepdims=True)
 
 
+#: BPCA size from which neighbour queries go through a kd-tree (below, all grains are tested)
+KD_TREE_FROM = 2048
+
+
 class _GrowingSet:
     """Positions of a growing cluster with neighbour queries: a kd-tree rebuilt
     every 256 grains, plus the grains added since."""
@@ -46,7 +50,7 @@ class _GrowingSet:
     def near(self, points: np.ndarray, distance: float) -> np.ndarray:
         """Indices of the grains within ``distance`` of any of ``points``; while the
         cluster is small, all of them (the caller tests exactly)."""
-        if self.n < 2048:
+        if self.n < KD_TREE_FROM:
             return np.arange(self.n)
         found = []
         if self.tree is not None:

@@ -92,6 +92,11 @@ def material(name: str, **overrides) -> Material:
     return dataclasses.replace(base, **overrides)
 
 
+def from_dict(fields: dict) -> Material:
+    """The material stored in a scene's metadata (``dataclasses.asdict`` of a Material)."""
+    return Material(**fields)
+
+
 @dataclasses.dataclass(frozen=True)
 class Scales:
     """Contact scales of two equal grains of radius ``r`` (SI)."""
