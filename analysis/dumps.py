@@ -1,15 +1,114 @@
-"""Reading the plugin's local contact dumps (dump local of compute jkr/dt/contacts)."""
+"""Reading a run's dumps, one frame at a time.
+
+* ``atoms.dump`` (``dump custom ... id type radius x y z vx vy vz c_coord``) is read
+  with MDAnalysis' LAMMPSDUMP reader; the extra per-atom columns (radius, the
+  coordination c_coord, ...) come with each frame. MDAnalysis keeps positions in
+  float32 and shifts them so that the box starts at 0: distances are good to about
+  1e-7 of the box size (1e-13 m for a micron box, far below delta_c).
+* ``contacts.dump`` (``dump local ... c_bonds[*]`` of compute jkr/dt/contacts:
+  id1 id2 delta a force |zeta| |xi| |phi|) has no MDAnalysis reader; it is read here
+  as a stream of snapshots.
+
+Both are generators: a long trajectory is never held in memory at once.
+"""
 
 from __future__ import annotations
 
+import dataclasses
+import warnings
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
 
+#: columns of compute jkr/dt/contacts, in the order of the local dump
+CONTACT_COLUMNS = ["id1", "id2", "delta", "a", "force", "zeta", "xi", "phi"]
+
+
+def atoms_universe(path, columns=("radius", "c_coord")):
+    """An MDAnalysis Universe over a ``dump custom`` file with the given extra columns
+    (those present in the file) in each frame's ``ts.data``."""
+    import MDAnalysis as mda
+
+    path = Path(path)
+    with path.open() as f:
+        header = next((line for line in f if line.startswith("ITEM: ATOMS")), None)
+    if header is None:
+        raise ValueError(f"{path}: not a LAMMPS dump (no 'ITEM: ATOMS' line)")
+    present = header.split()[2:]
+    missing = {"id", "x", "y", "z"} - set(present)
+    if missing:
+        raise ValueError(f"{path}: the dump lacks columns {sorted(missing)}; dump at least "
+                         "'id type radius x y z'")
+    extra = [c for c in columns if c in present]
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="Guessed all Masses")
+        warnings.filterwarnings("ignore", message="Reader has no dt information")
+        return mda.Universe(str(path), format="LAMMPSDUMP", topology_format="LAMMPSDUMP",
+                            additional_columns=extra, dt=1.0)
+
+
+def iter_local(path) -> Iterator[tuple[int, np.ndarray]]:
+    """(timestep, rows) of each snapshot of a ``dump local`` file, in file order."""
+    with Path(path).open() as f:
+        line = f.readline()
+        while line:
+            if not line.startswith("ITEM: TIMESTEP"):
+                raise ValueError(f"{path}: expected 'ITEM: TIMESTEP', found {line.strip()!r}")
+            step = int(f.readline())
+            f.readline()                              # ITEM: NUMBER OF ENTRIES
+            n = int(f.readline())
+            line = f.readline()
+            while line and not line.startswith("ITEM: ENTRIES"):
+                line = f.readline()                  # box bounds
+            rows = [f.readline().split() for _ in range(n)]
+            yield step, np.array(rows, dtype=float).reshape(n, -1)
+            line = f.readline()
+
 
 def last_local_snapshot(path) -> np.ndarray:
-    """Rows (id1 id2 delta a force) of the last snapshot of a ``dump local`` file."""
-    text = Path(path).read_text().split("ITEM: TIMESTEP")[-1]
-    body = text.split("ITEM: ENTRIES")[-1].splitlines()[1:]
-    rows = [[float(w) for w in line.split()] for line in body if line.strip()]
-    return np.array(rows, dtype=float).reshape(len(rows), -1)
+    """Rows (id1 id2 delta a force ...) of the last snapshot of a ``dump local`` file."""
+    rows = None
+    for _, rows in iter_local(path):
+        pass
+    if rows is None:
+        raise ValueError(f"{path}: no snapshot")
+    return rows
+
+
+@dataclasses.dataclass
+class Frame:
+    step: int
+    ids: np.ndarray          # (N,) atom IDs, ascending
+    x: np.ndarray            # (N, 3) positions, m (float64 from MDAnalysis' float32)
+    radius: np.ndarray       # (N,) m
+    pairs: np.ndarray | None  # (n_c, 2) atom IDs of bonded contacts, None without a contact dump
+
+
+def frames(run, atoms="atoms.dump", contacts="contacts.dump") -> Iterator[Frame]:
+    """The frames of a run directory: positions and radii from ``atoms``, joined by
+    timestep to the contact list of ``contacts`` when that file exists."""
+    run = Path(run)
+    u = atoms_universe(run / atoms)
+    order = np.argsort(u.atoms.ids)
+    ids = u.atoms.ids[order]
+    local = iter_local(run / contacts) if (run / contacts).exists() else None
+    pending = None
+    for ts in u.trajectory:
+        step = int(ts.data["step"])
+        pairs = None
+        if local is not None:
+            # both dumps are written every N steps; skip contact snapshots the atoms lack
+            while pending is None or pending[0] < step:
+                pending = next(local, None)
+                if pending is None:
+                    raise ValueError(f"{run / contacts} ends before step {step} of {atoms}")
+            if pending[0] != step:
+                raise ValueError(f"{run / contacts} has no snapshot at step {step}: write "
+                                 "both dumps at the same interval")
+            pairs = pending[1][:, :2].astype(np.int64)
+        radius = ts.data["radius"][order] if "radius" in ts.data else None
+        if radius is None:
+            raise ValueError(f"{run / atoms}: no radius column; dump 'id type radius x y z'")
+        yield Frame(step=step, ids=ids, x=ts.positions[order].astype(np.float64),
+                    radius=np.asarray(radius, dtype=np.float64), pairs=pairs)

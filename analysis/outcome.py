@@ -1,7 +1,15 @@
-"""Collision outcome from the final state: fragments, largest remnant, growth efficiency.
+"""Outcome metrics of a collision, per frame and at the end.
 
-A fragment is a connected component of the bonded-contact graph (the plugin's
-contact list). Growth efficiency f_gro = (N_lar - N_tar) / N_pro, 3D BPCA paper sec. 3.1.
+    N_lar, N_second   sizes of the largest and second-largest fragment
+    f_gro             growth efficiency (N_lar - N_tar) / N_pro   (3D BPCA paper, sec. 3.1)
+    r_g               gyration radius of the largest fragment     (Wada et al. 2007, eq. 50)
+    n_con             contacts per grain in the largest fragment, 2 n_contacts / N_lar
+                      (Wada et al. 2007, sec. 5.3, Fig. 11)
+    n_fragments       number of fragments
+    N_cum(<= N)       grains in fragments of at most N grains     (3D BPCA paper, sec. 3.2)
+
+and the scalings of Wada et al. (2007): E_imp / (n_k E_roll) and E_imp / (n_k E_break),
+with n_k = N_total - 2 the contacts of the two aggregates before impact (sec. 4).
 """
 
 from __future__ import annotations
@@ -9,51 +17,65 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 
-
-def fragments(n_atoms: int, pairs: np.ndarray) -> np.ndarray:
-    """Fragment label of each atom (0-based index = atom ID - 1) from contact pairs of atom IDs."""
-    pairs = np.asarray(pairs, dtype=int).reshape(-1, 2) - 1
-    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n_atoms, n_atoms))
-    return connected_components(graph, directed=False)[1]
+from . import fragments as frag
 
 
 @dataclasses.dataclass
 class Outcome:
+    step: int
     n_total: int
     n_largest: int
     n_second: int
     n_fragments: int
     growth_efficiency: float
-    gyration_radius_largest: float    # m, eq. (50) of Wada et al. (2007)
-    contacts_per_particle: float      # n_con = 2 n_contacts / N
-
-    def summary(self) -> str:
-        return "\n".join([
-            f"grains                      {self.n_total}",
-            f"largest remnant N_lar       {self.n_largest}",
-            f"second largest              {self.n_second}",
-            f"fragments                   {self.n_fragments}",
-            f"growth efficiency f_gro     {self.growth_efficiency:+.3f}",
-            f"r_g of largest              {self.gyration_radius_largest * 1e6:.3f} micron",
-            f"contacts per grain n_con    {self.contacts_per_particle:.3f}",
-        ])
+    gyration_radius_largest: float    # m
+    contacts_per_particle: float      # n_con of the largest fragment
 
 
-def outcome(x: np.ndarray, pairs: np.ndarray, n_target: int, n_projectile: int) -> Outcome:
-    """Outcome metrics for positions ``x`` (rows ordered by atom ID) and contact ``pairs``."""
-    labels = fragments(len(x), pairs)
+def gyration_radius(x: np.ndarray) -> float:
+    """Eq. (50) of Wada et al. (2007): r_g of equal grains about their centre of mass."""
+    return float(np.sqrt(((x - x.mean(axis=0)) ** 2).sum(axis=1).mean()))
+
+
+def measure(x: np.ndarray, labels: np.ndarray, pairs: np.ndarray, n_target: int,
+            n_projectile: int, step: int = 0) -> Outcome:
+    """Metrics of one frame: positions ``x`` (N, 3), fragment ``labels``, and the bonded
+    ``pairs`` as 0-based index pairs (those the labels were built from)."""
+    if n_target + n_projectile != len(x):
+        raise ValueError(f"N_tar + N_pro = {n_target + n_projectile} but the frame has "
+                         f"{len(x)} grains: the metadata belong to another run")
     sizes = np.bincount(labels)
-    order = np.argsort(sizes)[::-1]
-    largest = labels == order[0]
-    xl = x[largest]
-    rg = float(np.sqrt(((xl - xl.mean(axis=0)) ** 2).sum(axis=1).mean()))
+    ranked = np.argsort(sizes)[::-1]
+    largest = labels == ranked[0]
+    pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    inside = largest[pairs[:, 0]] & largest[pairs[:, 1]]
+    n_lar = int(sizes[ranked[0]])
     return Outcome(
-        n_total=len(x), n_largest=int(sizes[order[0]]),
-        n_second=int(sizes[order[1]]) if len(sizes) > 1 else 0,
+        step=int(step), n_total=len(x), n_largest=n_lar,
+        n_second=int(sizes[ranked[1]]) if len(sizes) > 1 else 0,
         n_fragments=len(sizes),
-        growth_efficiency=(sizes[order[0]] - n_target) / n_projectile,
-        gyration_radius_largest=rg,
-        contacts_per_particle=2.0 * len(pairs) / len(x))
+        growth_efficiency=(n_lar - n_target) / n_projectile,
+        gyration_radius_largest=gyration_radius(x[largest]),
+        contacts_per_particle=2.0 * int(inside.sum()) / n_lar)
+
+
+def measure_frame(frame, n_target: int, n_projectile: int, tolerance: float | None = None):
+    """Fragments and metrics of a ``dumps.Frame``: from its contact list, or from positions
+    with ``tolerance`` (normally delta_c) when the frame has none. Returns (labels, Outcome)."""
+    if frame.pairs is not None:
+        index = np.searchsorted(frame.ids, frame.pairs)
+        labels = frag.from_contacts(frame.ids, frame.pairs)
+    else:
+        if tolerance is None:
+            raise ValueError("no contact list in this run: give the position tolerance "
+                             "(delta_c of the material)")
+        index = frag.position_pairs(frame.x, frame.radius, tolerance)
+        labels = frag.from_positions(frame.x, frame.radius, tolerance)
+    return labels, measure(frame.x, labels, index, n_target, n_projectile, frame.step)
+
+
+def energy_scalings(e_imp: float, n_k: int, e_roll: float | None, e_break: float) -> dict:
+    """E_imp in units of n_k E_roll and of n_k E_break (Wada et al. 2007, Table 1)."""
+    return dict(E_imp_over_nk_Eroll=None if e_roll is None else e_imp / (n_k * e_roll),
+                E_imp_over_nk_Ebreak=e_imp / (n_k * e_break))

@@ -1,14 +1,19 @@
 """Command line of jkr/dt.
 
+  jkrdt build   build one aggregate (BPCA or BCCA, 2D or 3D) and write it as a data file
   jkrdt setup   build target and projectile (BPCA or BCCA, 2D or 3D) and write a
                 collision: data file + collision.json (metadata)
   jkrdt run     run a collision written by setup with inputs/collision.lmp
-  jkrdt demo    both, for two 500-grain ice BPCAs, and report the outcome with a picture
+  jkrdt analyse analyse a run directory: outcome per frame and at the end, tables, pictures
+  jkrdt campaign run a grid of v_col x B_off^2 x seeds from a JSON spec (resumable)
+  jkrdt summarise B_off-weighted campaign statistics (<f_gro>, v_fra, N_cum), tables, plots
+  jkrdt demo    setup + run + analyse for two 500-grain ice BPCAs: summary and a picture
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import subprocess
 import sys
@@ -18,19 +23,11 @@ from pathlib import Path
 import numpy as np
 
 from . import collision
-from .aggregates import bcca, bpca
+from .aggregates import bonds, bpca, gyration_radius
+from .campaign import BUILDERS
+from .datafile import write_sphere_data
 from .materials import PRESETS, material, scales
-
-DECK = "collision.lmp"
-
-
-def find_deck() -> Path:
-    here = Path(__file__).resolve()
-    for base in [Path.cwd(), *here.parents]:
-        deck = base / "inputs" / DECK
-        if deck.exists():
-            return deck
-    raise FileNotFoundError(f"inputs/{DECK} not found; run from the repository root")
+from .session import find_deck, scene_variables, write_scene_deck
 
 
 def run_lammps(deck: Path, out: Path, variables: dict, nproc: int = 1) -> None:
@@ -47,16 +44,56 @@ def run_lammps(deck: Path, out: Path, variables: dict, nproc: int = 1) -> None:
         raise SystemExit("LAMMPS failed:\n" + "\n".join(errors) + f"\n(full log: {out / 'log.lammps'})")
 
 
-BUILDERS = {"bpca": bpca, "bcca": bcca}
 
 
-def model_words(model: str, mat) -> str:
-    """pair_coeff words of a model of the 3D BPCA paper."""
-    return "frictionless" if model == "frictionless" else f"xi_crit {mat.xi_crit!r}"
+MATERIAL_FIELDS = ("gamma", "E", "nu", "G", "density", "xi_crit", "tvis")
+
+
+def chosen_material(args):
+    """The preset named by --material with any of --gamma, --E, ... overriding it."""
+    overrides = {f: getattr(args, f) for f in MATERIAL_FIELDS if getattr(args, f) is not None}
+    try:
+        return material(args.material, **overrides)
+    except ValueError as err:
+        raise SystemExit(f"jkrdt: {err}") from None
+
+
+def add_material_options(p) -> None:
+    p.add_argument("--material", choices=list(PRESETS), default="ice",
+                   help="preset of Wada et al. (2007) Table 2; the options below override it")
+    p.add_argument("--gamma", type=float, help="surface energy, J/m^2")
+    p.add_argument("--E", type=float, help="Young's modulus, Pa")
+    p.add_argument("--nu", type=float, help="Poisson ratio")
+    p.add_argument("--G", type=float, help="shear modulus, Pa (default E / (2 (1 + nu)))")
+    p.add_argument("--density", type=float, help="kg/m^3")
+    p.add_argument("--xi-crit", dest="xi_crit", type=float, help="critical rolling displacement, m")
+    p.add_argument("--tvis", type=float, help="viscoelastic time of eq. (A.5), s")
+    p.add_argument("--radius", type=float, default=1.0e-7, help="grain radius, m")
+
+
+def build(args) -> int:
+    mat = chosen_material(args)
+    s = scales(mat, args.radius)
+    t0 = time.time()
+    x = BUILDERS[args.kind](args.n, args.radius, s.delta0, np.random.default_rng(args.seed),
+                            dim=args.dim)
+    built = time.time() - t0
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    write_sphere_data(out / "aggregate.data", x, args.radius, mat.density,
+                      title=f"jkr/dt {args.kind.upper()} of {args.n} {mat.name} grains")
+    meta = dict(kind=args.kind, dimension=args.dim, N=args.n, seed=args.seed, radius=args.radius,
+                material=dataclasses.asdict(mat), r_g=gyration_radius(x),
+                n_bonds=len(bonds(x, args.radius, s.delta0)), build_seconds=built)
+    (out / "aggregate.json").write_text(json.dumps(meta, indent=2))
+    print(f"{args.kind.upper()} of {args.n} grains ({args.dim}D) built in {built:.2f} s: "
+          f"r_g = {meta['r_g'] / args.radius:.3f} r, {meta['n_bonds']} bonds; "
+          f"wrote {out / 'aggregate.data'} and aggregate.json")
+    return 0
 
 
 def setup(args) -> int:
-    mat = material(args.material)
+    mat = chosen_material(args)
     s = scales(mat, args.radius)
     rng = np.random.default_rng(args.seed)
     build = BUILDERS[args.kind]
@@ -68,37 +105,29 @@ def setup(args) -> int:
                          material=mat, dim=args.dim, seed=args.seed)
     c.meta.update(kind=args.kind, model=args.model, build_seconds=built)
     data = collision.write(c, mat, args.out)
+    deck = write_scene_deck(args.out)
     print(f"{args.kind.upper()} {args.n_tar} + {args.n_pro} ({args.dim}D, {mat.name}) built in "
-          f"{built:.1f} s; E_imp = {c.meta['E_imp']:.3e} J; wrote {data} and collision.json")
+          f"{built:.1f} s; E_imp = {c.meta['E_imp']:.3e} J; wrote {data}, collision.json "
+          f"and {deck.name}")
     return 0
 
 
 def run(args) -> int:
     out = Path(args.dir).resolve()
-    meta = json.loads((out / "collision.json").read_text())
-    mat = material(meta["material"]["name"], **{k: v for k, v in meta["material"].items()
-                                                 if k != "name"})
-    s = scales(mat, meta["radius"])
-    model = args.model or meta.get("model", "frictional")
+    variables = scene_variables(out, args.model, args.dt)
+    variables.update(out=out, steps=args.steps, every=max(1, args.steps // 20))
     t0 = time.time()
-    run_lammps(find_deck(), out, dict(file=out / "collision.data", out=out, steps=args.steps,
-                                      every=max(1, args.steps // 20), dt=args.dt * s.t_c,
-                                      model=model_words(model, mat), dim=meta["dimension"],
-                                      gamma=mat.gamma, E=mat.E, nu=mat.nu, tvis=mat.tvis),
-               nproc=args.np)
-    print(f"ran {args.steps} steps ({model}) in {time.time() - t0:.1f} s on {args.np} rank(s); "
+    run_lammps(find_deck(), out, variables, nproc=args.np)
+    print(f"ran {args.steps} steps ({variables['model']}) in {time.time() - t0:.1f} s on "
+          f"{args.np} rank(s); "
           f"log, dumps and restarts in {out}")
     return 0
 
 
 def demo(args) -> int:
-    from jkrdt.analysis.dumps import last_local_snapshot
-    from jkrdt.analysis.outcome import fragments, outcome
-    from jkrdt.analysis.plots import snapshot
-    from jkrdt.analysis.thermo import CHANNELS, energy_budget, read_thermo
+    from jkrdt.analysis.run import analyse_run, summary_text
 
     out = Path(args.out).resolve()
-    out.mkdir(parents=True, exist_ok=True)
     mat = material("ice")
     r = 1.0e-7
     s = scales(mat, r)
@@ -108,39 +137,50 @@ def demo(args) -> int:
     pro = bpca(args.n, r, s.delta0, rng)
     c = collision.set_up(tar, pro, r, v_col=args.v, b_off=args.b_off, rng=rng,
                          material=mat, seed=args.seed)
-    data = collision.write(c, mat, out)
+    c.meta.update(kind="bpca", model=args.model)
+    collision.write(c, mat, out)
     print(f"built 2 BPCA of {args.n} grains and set up the collision in {time.time() - t0:.1f} s")
 
-    dt = 0.014 * s.t_c
-    model = model_words(args.model, mat)
+    variables = scene_variables(out, args.model)
+    variables.update(out=out, steps=args.steps, every=args.steps // 20)
     t0 = time.time()
-    run_lammps(find_deck(), out, dict(file=data, out=out, steps=args.steps, every=args.steps // 20,
-                                      dt=dt, model=model), nproc=args.np)
-    wall = time.time() - t0
-    print(f"ran {args.steps} steps of {2 * args.n} grains in {wall:.1f} s on {args.np} rank(s)")
-
-    final = np.loadtxt(out / "final.dump", skiprows=9)
-    final = final[np.argsort(final[:, 0])]
-    pairs = last_local_snapshot(out / "contacts.dump")[:, :2].astype(int)
-    result = outcome(final[:, 1:4], pairs, args.n, args.n)
-    budget = energy_budget(read_thermo(out / "log.lammps"))
-    e_imp = c.meta["E_imp"]
-    error = float(np.abs(budget["total"] - budget["total"][0]).max() / e_imp)
-    pictures = snapshot(out / "outcome", final[:, 1:4], fragments(len(final), pairs),
-                        f"ice BPCA {args.n}+{args.n}, v = {args.v} m/s, B_off = {args.b_off}, "
-                        f"{args.model} model")
-    channels = {name: float(budget[name][-1] / e_imp) for name in CHANNELS}
-    summary = dict(dataclass=result.__dict__, E_imp=e_imp, energy_error=error, model=args.model,
-                   dissipated_fraction=float(budget["dissipated"][-1] / e_imp),
-                   dissipated_by_channel=channels, wall_seconds=wall)
-    (out / "summary.json").write_text(json.dumps(summary, indent=2, default=float))
+    run_lammps(find_deck(), out, variables, nproc=args.np)
+    print(f"ran {args.steps} steps of {2 * args.n} grains in {time.time() - t0:.1f} s on "
+          f"{args.np} rank(s)")
     print()
-    print(result.summary())
-    print(f"impact energy E_imp         {e_imp:.3e} J")
-    print(f"dissipated / E_imp          {summary['dissipated_fraction']:.3f}  ("
-          + ", ".join(f"{k} {v:.3f}" for k, v in channels.items()) + ")")
-    print(f"max |dE| / E_imp            {error:.2e}")
-    print(f"picture                     {pictures[0]}")
+    print(summary_text(analyse_run(out)))
+    print(f"tables                      {out / 'frames.csv'}, {out / 'outcome.json'}")
+    return 0
+
+
+def analyse(args) -> int:
+    from jkrdt.analysis.run import analyse_run, summary_text
+
+    out = analyse_run(args.dir, tolerance=args.tolerance, plots=not args.no_plots)
+    print(summary_text(out))
+    return 0
+
+
+def campaign(args) -> int:
+    from .campaign import run_campaign
+
+    done = run_campaign(args.spec, args.dir, progress=not args.quiet)
+    print(f"{done['ran']} run(s) done, {done['skipped']} already finished, in {args.dir}")
+    return 0
+
+
+def summarise(args) -> int:
+    from jkrdt.analysis.campaign import summarise as summarise_campaign
+
+    summary = summarise_campaign(args.dir, plot=not args.no_plots)
+    for row in summary["table"]:
+        print(f"{row['model']:<40} v_col {row['v_col']:7.3g} m/s  <f_gro> {row['mean_f_gro']:+.3f}"
+              f"  ({row['runs']} runs)")
+    for model, v in summary["v_fra"].items():
+        print(f"v_fra ({model}): " + (f"{v:.3g} m/s" if v else "no crossing of <f_gro> = 0"))
+    for p in summary.get("pictures", []):
+        if p.endswith(".png"):
+            print(f"picture: {p}")
     return 0
 
 
@@ -165,11 +205,17 @@ def main(argv=None) -> int:
     st.add_argument("--n-pro", type=int, default=256, help="grains in the projectile")
     st.add_argument("--v", type=float, default=20.0, help="collision speed, m/s")
     st.add_argument("--b-off", type=float, default=0.0, help="impact parameter B_off")
-    st.add_argument("--material", choices=list(PRESETS), default="ice")
-    st.add_argument("--radius", type=float, default=1.0e-7, help="grain radius, m")
+    add_material_options(st)
     st.add_argument("--model", choices=["frictional", "frictionless"], default="frictional")
     st.add_argument("--seed", type=int, default=1)
     st.add_argument("--out", default="runs/scene")
+    bd = sub.add_parser("build", help="build one aggregate and write it as a data file")
+    bd.add_argument("--kind", choices=list(BUILDERS), default="bpca")
+    bd.add_argument("--dim", type=int, choices=[2, 3], default=3)
+    bd.add_argument("--n", type=int, default=1024, help="grains (a power of two for BCCA)")
+    bd.add_argument("--seed", type=int, default=1)
+    bd.add_argument("--out", default="runs/aggregate")
+    add_material_options(bd)
     rn = sub.add_parser("run", help="run a scene written by 'jkrdt setup'")
     rn.add_argument("dir", help="directory with collision.data and collision.json")
     rn.add_argument("--steps", type=int, default=20000)
@@ -177,8 +223,25 @@ def main(argv=None) -> int:
     rn.add_argument("--model", choices=["frictional", "frictionless"], default=None,
                     help="default: the model in collision.json")
     rn.add_argument("--np", type=int, default=1, help="MPI ranks")
+    an = sub.add_parser("analyse", help="outcome of a run directory: metrics per frame, "
+                        "outcome.json, frames.csv, pictures")
+    an.add_argument("dir")
+    an.add_argument("--tolerance", type=float, default=None,
+                    help="position tolerance on r_i + r_j when the run has no contact dump, "
+                         "m (default delta_c)")
+    an.add_argument("--no-plots", action="store_true")
+    cp = sub.add_parser("campaign", help="run a grid of collisions from a JSON spec "
+                        "(resumes: finished runs are skipped)")
+    cp.add_argument("spec")
+    cp.add_argument("dir")
+    cp.add_argument("--quiet", action="store_true")
+    sm = sub.add_parser("summarise", help="B_off-weighted statistics of a campaign: "
+                        "runs.csv, summary.csv, summary.json, plots")
+    sm.add_argument("dir")
+    sm.add_argument("--no-plots", action="store_true")
     args = parser.parse_args(argv)
-    return {"demo": demo, "setup": setup, "run": run}[args.command](args)
+    return {"demo": demo, "build": build, "setup": setup, "run": run, "analyse": analyse,
+            "campaign": campaign, "summarise": summarise}[args.command](args)
 
 
 if __name__ == "__main__":

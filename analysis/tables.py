@@ -1,0 +1,45 @@
+"""Results files: CSV tables (one row per frame or per run) and JSON, written to a
+temporary name and renamed, so a reader never sees half a file and an interrupted
+write never replaces a finished one."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from pathlib import Path
+
+
+def write_atomic(path, text: str) -> Path:
+    path = Path(path)
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text)
+    tmp.replace(path)
+    return path
+
+
+def write_json(path, data) -> Path:
+    return write_atomic(path, json.dumps(data, indent=2, default=float) + "\n")
+
+
+def write_csv(path, rows: list[dict]) -> Path:
+    """Rows of dicts; the columns are the union of their keys, in first-seen order."""
+    columns: list[str] = []
+    for row in rows:
+        columns += [k for k in row if k not in columns]
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=columns, lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    return write_atomic(path, buffer.getvalue())
+
+
+def read_csv(path) -> list[dict]:
+    """Rows of a CSV written by ``write_csv``, numbers as floats where they parse."""
+    def value(text):
+        try:
+            return float(text)
+        except ValueError:
+            return text
+    with Path(path).open() as f:
+        return [{k: value(v) for k, v in row.items()} for row in csv.DictReader(f)]
