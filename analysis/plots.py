@@ -34,21 +34,31 @@ def _save(fig, path) -> list[Path]:
     return out
 
 
-def snapshot(path, x: np.ndarray, labels: np.ndarray, title: str = "") -> list[Path]:
-    """Projections x-y and x-z of the grains: the largest fragment, the next nine, the rest."""
+def snapshot(path, x: np.ndarray, labels: np.ndarray, title: str = "",
+             radius: float | None = None) -> list[Path]:
+    """Projections x-y and x-z of the grains, drawn to scale when ``radius`` is given:
+    the largest fragment blue, the next nine in their own colours, the rest grey."""
     plt = _pyplot()
     sizes = np.bincount(labels)
     rank = np.empty_like(sizes)
     rank[np.argsort(sizes)[::-1]] = np.arange(len(sizes))
     colour = np.minimum(rank[labels], 10)
     fig, axes = plt.subplots(1, 2, figsize=(10, 5), constrained_layout=True)
-    um = (x - x.mean(axis=0)) * 1e6
+    order = np.argsort(colour, kind="stable")      # the largest first, fragments on top
+    um = (x[order] - x.mean(axis=0)) * 1e6
+    dots = []
     for ax, (i, j, name) in zip(axes, [(0, 1, "y"), (0, 2, "z")]):
-        ax.scatter(um[:, i], um[:, j], c=colour, cmap="tab10", s=4, vmin=0, vmax=10)
+        dots.append(ax.scatter(um[:, i], um[:, j], c=colour[order], cmap="tab10", s=4, vmin=0,
+                               vmax=10, edgecolors="k", linewidths=0.2))
         ax.set_xlabel("x (micron)")
         ax.set_ylabel(f"{name} (micron)")
         ax.set_aspect("equal")
     fig.suptitle(title + f"\n{len(sizes)} fragments; largest {sizes.max()} grains (blue)")
+    if radius:
+        fig.canvas.draw()                      # final axes sizes, then grains at their size
+        for ax, dot in zip(axes, dots):
+            points_per_um = ax.get_window_extent().width * 72 / fig.dpi / np.ptp(ax.get_xlim())
+            dot.set_sizes([(2 * radius * 1e6 * points_per_um) ** 2])
     return _save(fig, path)
 
 

@@ -73,7 +73,8 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True) -> dict
     if plots:
         title = (f"{mat.name} {(meta.get('kind') or '').upper()} {n_tar}+{n_pro}, "
                  f"v = {meta['v_col']:g} m/s, B_off = {meta['B_off']:g}, {meta.get('model', '')}")
-        out["pictures"] = [str(p) for p in snapshot(run / "outcome", frame.x, labels, title)]
+        out["pictures"] = [str(p) for p in snapshot(run / "outcome", frame.x, labels, title,
+                                                           radius=meta["radius"])]
         if budget is not None:
             out["pictures"] += [str(p) for p in energy_partition(run / "energy", thermo["Time"],
                                                                  budget, meta["E_imp"], title)]
