@@ -92,10 +92,10 @@ def compression(path, rows: list[dict]):
     fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4.5), constrained_layout=True)
     e = np.logspace(np.log10(max(x.min(), 1e-3)) - 0.5, np.log10(x.max()) + 0.5, 50)
     a.loglog(x, rg, "o")
-    a.loglog(e, 0.84 * e ** -0.12, "0.6", label="eq. (51)")
+    a.loglog(e, 0.84 * e ** -0.12, "0.6", label="eq. (51), 2D BCCA")
     a.set_ylabel("r_g / (r_1 N_lar^1/2)")
     b.loglog(x, ncon - 1, "o")
-    b.loglog(e, e ** 0.75, "0.6", label="eq. (56)")
+    b.loglog(e, e ** 0.75, "0.6", label="eq. (56), 2D BCCA")
     b.set_ylabel("n_con - 1")
     for ax in (a, b):
         ax.set_xlabel("E_imp / (n_k E_roll)")
@@ -139,7 +139,8 @@ def cumulative(path, curves: dict):
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(6, 4.5), constrained_layout=True)
     for label, (n, c) in curves.items():
-        ax.loglog(n, np.maximum(c, 1e-3), drawstyle="steps-post", label=label)
+        c = np.asarray(c, dtype=float)
+        ax.loglog(n, np.where(c > 0, c, np.nan), drawstyle="steps-post", label=label)
     ax.set_xlabel("N")
     ax.set_ylabel("<N_cum(<= N)>")
     ax.legend(fontsize=8)
