@@ -83,3 +83,17 @@ def test_campaign_under_two_ranks_matches_serial(campaign, tmp_path):
             assert parallel[key] == serial[key], (path, key)
         assert parallel["gyration_radius_largest"] == pytest.approx(
             serial["gyration_radius_largest"], rel=1e-9)
+
+
+def test_spec_errors_name_the_fix(tmp_path):
+    spec = tmp_path / "spec.json"
+    spec.write_text(json.dumps(dict(SPEC, seed=[3])))
+    with pytest.raises(ValueError, match=r"unknown keys \['seed'\]"):
+        run_campaign(spec, tmp_path / "runs", progress=False)
+    spec.write_text(json.dumps(dict(SPEC, b_off2=[0.0, 2.0])))
+    with pytest.raises(ValueError, match="must lie in"):
+        run_campaign(spec, tmp_path / "runs", progress=False)
+    spec.write_text(json.dumps(dict(SPEC, steps=4500)))
+    with pytest.raises(ValueError, match="multiple of every"):
+        run_campaign(spec, tmp_path / "runs", progress=False)
+    assert not (tmp_path / "runs").exists()

@@ -33,7 +33,12 @@ REQUIRED = ["n_tar", "n_pro", "v_col", "b_off2", "steps"]
 
 
 def read_spec(path) -> dict:
-    spec = dict(DEFAULTS, **json.loads(Path(path).read_text()))
+    given = json.loads(Path(path).read_text())
+    unknown = sorted(set(given) - set(DEFAULTS) - set(REQUIRED))
+    if unknown:
+        raise ValueError(f"{path}: unknown keys {unknown}; known: "
+                         f"{sorted(set(DEFAULTS) | set(REQUIRED))}")
+    spec = dict(DEFAULTS, **given)
     missing = [k for k in REQUIRED if k not in spec]
     if missing:
         raise ValueError(f"{path}: the campaign spec lacks {missing}")

@@ -44,6 +44,9 @@ def run_lammps(deck: Path, out: Path, variables: dict, nproc: int = 1) -> None:
         raise SystemExit("LAMMPS failed:\n" + "\n".join(errors) + f"\n(full log: {out / 'log.lammps'})")
 
 
+def output_interval(steps: int) -> int:
+    """About steps/20, dividing steps, so that the last dump is the end of the run."""
+    return next(d for d in range(max(1, steps // 20), 0, -1) if steps % d == 0)
 
 
 MATERIAL_FIELDS = ("gamma", "E", "nu", "G", "density", "xi_crit", "tvis")
@@ -115,7 +118,7 @@ def setup(args) -> int:
 def run(args) -> int:
     out = Path(args.dir).resolve()
     variables = scene_variables(out, args.model, args.dt)
-    variables.update(out=out, steps=args.steps, every=max(1, args.steps // 20))
+    variables.update(out=out, steps=args.steps, every=output_interval(args.steps))
     t0 = time.time()
     run_lammps(find_deck(), out, variables, nproc=args.np)
     print(f"ran {args.steps} steps ({variables['model']}) in {time.time() - t0:.1f} s on "
@@ -142,7 +145,7 @@ def demo(args) -> int:
     print(f"built 2 BPCA of {args.n} grains and set up the collision in {time.time() - t0:.1f} s")
 
     variables = scene_variables(out, args.model)
-    variables.update(out=out, steps=args.steps, every=args.steps // 20)
+    variables.update(out=out, steps=args.steps, every=output_interval(args.steps))
     t0 = time.time()
     run_lammps(find_deck(), out, variables, nproc=args.np)
     print(f"ran {args.steps} steps of {2 * args.n} grains in {time.time() - t0:.1f} s on "
