@@ -107,8 +107,7 @@ def frames(run, atoms="atoms.dump", contacts="contacts.dump") -> Iterator[Frame]
                 raise ValueError(f"{run / contacts} has no snapshot at step {step}: write "
                                  "both dumps at the same interval")
             pairs = pending[1][:, :2].astype(np.int64)
-        radius = ts.data["radius"][order] if "radius" in ts.data else None
-        if radius is None:
+        if "radius" not in ts.data:
             raise ValueError(f"{run / atoms}: no radius column; dump 'id type radius x y z'")
         yield Frame(step=step, ids=ids, x=ts.positions[order].astype(np.float64),
-                    radius=np.asarray(radius, dtype=np.float64), pairs=pairs)
+                    radius=np.asarray(ts.data["radius"][order], dtype=np.float64), pairs=pairs)

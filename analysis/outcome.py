@@ -18,6 +18,8 @@ import dataclasses
 
 import numpy as np
 
+from jkrdt.aggregates import gyration_radius
+
 from . import fragments as frag
 
 
@@ -31,11 +33,6 @@ class Outcome:
     growth_efficiency: float
     gyration_radius_largest: float    # m
     contacts_per_particle: float      # n_con of the largest fragment
-
-
-def gyration_radius(x: np.ndarray) -> float:
-    """Eq. (50) of Wada et al. (2007): r_g of equal grains about their centre of mass."""
-    return float(np.sqrt(((x - x.mean(axis=0)) ** 2).sum(axis=1).mean()))
 
 
 def measure(x: np.ndarray, labels: np.ndarray, pairs: np.ndarray, n_target: int,

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from . import collision
-from .aggregates import bonds, bpca, gyration_radius
+from .aggregates import bonds, gyration_radius
 from .campaign import BUILDERS
 from .datafile import write_sphere_data
 from .materials import PRESETS, material, scales
@@ -95,35 +95,42 @@ def build(args) -> int:
     return 0
 
 
-def setup(args) -> int:
-    mat = chosen_material(args)
-    s = scales(mat, args.radius)
-    rng = np.random.default_rng(args.seed)
-    build = BUILDERS[args.kind]
+def write_scene(kind, n_tar, n_pro, radius, mat, v, b_off, seed, dim, model, out):
+    """Build target and projectile, set up their collision and write the scene into ``out``."""
+    s = scales(mat, radius)
+    rng = np.random.default_rng(seed)
+    build = BUILDERS[kind]
     t0 = time.time()
-    tar = build(args.n_tar, args.radius, s.delta0, rng, dim=args.dim)
-    pro = build(args.n_pro, args.radius, s.delta0, rng, dim=args.dim)
+    tar = build(n_tar, radius, s.delta0, rng, dim=dim)
+    pro = build(n_pro, radius, s.delta0, rng, dim=dim)
     built = time.time() - t0
-    c = collision.set_up(tar, pro, args.radius, v_col=args.v, b_off=args.b_off, rng=rng,
-                         material=mat, dim=args.dim, seed=args.seed)
-    c.meta.update(kind=args.kind, model=args.model, build_seconds=built)
-    data = collision.write(c, mat, args.out)
-    deck = write_scene_deck(args.out)
-    print(f"{args.kind.upper()} {args.n_tar} + {args.n_pro} ({args.dim}D, {mat.name}) built in "
-          f"{built:.1f} s; E_imp = {c.meta['E_imp']:.3e} J; wrote {data}, collision.json "
-          f"and {deck.name}")
+    c = collision.set_up(tar, pro, radius, v_col=v, b_off=b_off, rng=rng, material=mat,
+                         dim=dim, seed=seed)
+    c.meta.update(kind=kind, model=model, build_seconds=built)
+    data = collision.write(c, mat, out)
+    deck = write_scene_deck(out)
+    print(f"{kind.upper()} {n_tar} + {n_pro} ({dim}D, {mat.name}) built in {built:.1f} s; "
+          f"E_imp = {c.meta['E_imp']:.3e} J; wrote {data}, collision.json and {deck.name}")
+
+
+def run_scene(out: Path, model, dt: float, steps: int, nproc: int) -> None:
+    """Run a scene written by ``write_scene`` with the deck, in its own directory."""
+    variables = scene_variables(out, model, dt)
+    variables.update(out=out, steps=steps, every=output_interval(steps))
+    t0 = time.time()
+    run_lammps(find_deck(), out, variables, nproc=nproc)
+    print(f"ran {steps} steps ({variables['model']}) in {time.time() - t0:.1f} s on "
+          f"{nproc} rank(s); log, dumps and restarts in {out}")
+
+
+def setup(args) -> int:
+    write_scene(args.kind, args.n_tar, args.n_pro, args.radius, chosen_material(args), args.v,
+                args.b_off, args.seed, args.dim, args.model, args.out)
     return 0
 
 
 def run(args) -> int:
-    out = Path(args.dir).resolve()
-    variables = scene_variables(out, args.model, args.dt)
-    variables.update(out=out, steps=args.steps, every=output_interval(args.steps))
-    t0 = time.time()
-    run_lammps(find_deck(), out, variables, nproc=args.np)
-    print(f"ran {args.steps} steps ({variables['model']}) in {time.time() - t0:.1f} s on "
-          f"{args.np} rank(s); "
-          f"log, dumps and restarts in {out}")
+    run_scene(Path(args.dir).resolve(), args.model, args.dt, args.steps, args.np)
     return 0
 
 
@@ -131,25 +138,9 @@ def demo(args) -> int:
     from jkrdt.analysis.run import analyse_run, summary_text
 
     out = Path(args.out).resolve()
-    mat = material("ice")
-    r = 1.0e-7
-    s = scales(mat, r)
-    rng = np.random.default_rng(args.seed)
-    t0 = time.time()
-    tar = bpca(args.n, r, s.delta0, rng)
-    pro = bpca(args.n, r, s.delta0, rng)
-    c = collision.set_up(tar, pro, r, v_col=args.v, b_off=args.b_off, rng=rng,
-                         material=mat, seed=args.seed)
-    c.meta.update(kind="bpca", model=args.model)
-    collision.write(c, mat, out)
-    print(f"built 2 BPCA of {args.n} grains and set up the collision in {time.time() - t0:.1f} s")
-
-    variables = scene_variables(out, args.model)
-    variables.update(out=out, steps=args.steps, every=output_interval(args.steps))
-    t0 = time.time()
-    run_lammps(find_deck(), out, variables, nproc=args.np)
-    print(f"ran {args.steps} steps of {2 * args.n} grains in {time.time() - t0:.1f} s on "
-          f"{args.np} rank(s)")
+    write_scene("bpca", args.n, args.n, 1.0e-7, material("ice"), args.v, args.b_off, args.seed,
+                3, args.model, out)
+    run_scene(out, args.model, 0.014, args.steps, args.np)
     print()
     print(summary_text(analyse_run(out)))
     print(f"tables                      {out / 'frames.csv'}, {out / 'outcome.json'}")
