@@ -16,6 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
+from jkrdt.stopping import COMPLETE
+
 from . import plots
 from .tables import write_csv, write_json
 
@@ -23,7 +25,8 @@ SCALARS = ["model", "material", "xi_crit", "tvis", "kind", "dimension", "N_tar",
            "v_col", "B_off", "seed", "radius", "E_imp", "n_k", "E_imp_over_nk_Eroll",
            "E_imp_over_nk_Ebreak", "step", "n_total", "n_largest", "n_second", "n_fragments",
            "growth_efficiency", "gyration_radius_largest", "contacts_per_particle",
-           "dissipated_fraction", "energy_error", "run"]
+           "dissipated_fraction", "energy_error", "energy_warning", "stop_reason", "stop_step",
+           "kinetic_left", "problem", "run"]
 
 
 def b_off_average(b_off2, values) -> np.ndarray:
@@ -74,16 +77,37 @@ def load_outcomes(campaign) -> list[dict]:
     return [json.loads(p.read_text()) for p in sorted(Path(campaign).rglob("outcome.json"))]
 
 
-def summarise(campaign, plot: bool = True) -> dict:
+def summarise(campaign, plot: bool = True, include_cap: bool = False) -> dict:
     """Collect every run under ``campaign`` into runs.csv, and write summary.csv (one row
     per model and v_col: <f_gro>, <N_lar/N_total>, ...), summary.json (with v_fra) and
-    the campaign plots."""
+    the campaign plots.
+
+    Only complete runs (settled, or of a fixed number of steps) enter the averages; runs
+    that hit the settle cap enter with ``include_cap``, failed runs never. Each row of
+    the table counts the runs left out, and summary.json lists them."""
     campaign = Path(campaign)
-    outcomes = load_outcomes(campaign)
-    if not outcomes:
+    every = load_outcomes(campaign)
+    if not every:
         raise ValueError(f"{campaign}: no outcome.json below it; run 'jkrdt analyse' on its runs")
-    rows = [{k: o.get(k) for k in SCALARS} for o in outcomes]
+    rows = [{k: o.get(k, "steps" if k == "stop_reason" else None) for k in SCALARS}
+            for o in every]
     write_csv(campaign / "runs.csv", rows)
+    allowed = set(COMPLETE) | ({"cap"} if include_cap else set())
+    outcomes = [o for o in every if o.get("stop_reason", "steps") in allowed]
+    left_out = [dict(run=o["run"], stop_reason=o.get("stop_reason"), problem=o.get("problem"))
+                for o in every if o.get("stop_reason", "steps") not in allowed]
+    capped = defaultdict(int)
+    for o in every:
+        if o.get("stop_reason") == "cap":
+            capped[(label(o), o["v_col"])] += 1
+    dropped = defaultdict(int)
+    for o in every:
+        if o.get("stop_reason", "steps") not in allowed:
+            dropped[(label(o), o["v_col"])] += 1
+    if not outcomes:
+        raise ValueError(f"{campaign}: none of its {len(every)} runs is complete "
+                         f"({sorted({d['stop_reason'] for d in left_out})}); see runs.csv")
+    rows = [{k: o.get(k) for k in SCALARS} for o in outcomes]
 
     groups = defaultdict(list)
     for o in outcomes:
@@ -101,7 +125,8 @@ def summarise(campaign, plot: bool = True) -> dict:
         cum = [np.mean([cumulative_on(n_grid, o["fragment_sizes"], o["N_cum"])
                         for o in by_b2[b]], axis=0) for b in b2]
         mean_f = float(b_off_average(b2, f))
-        table.append(dict(model=name, v_col=v, runs=len(runs), B_off2_values=len(b2),
+        table.append(dict(model=name, v_col=v, runs=len(runs), left_out=dropped[(name, v)],
+                          capped=capped[(name, v)], B_off2_values=len(b2),
                           mean_f_gro=mean_f, mean_N_lar_over_N_total=float(b_off_average(b2, lar)),
                           E_imp_over_nk_Ebreak=runs[0]["E_imp_over_nk_Ebreak"]))
         curves[name][0].append(v)
@@ -109,7 +134,8 @@ def summarise(campaign, plot: bool = True) -> dict:
         cumulative[f"{name}, {v:g} m/s"] = (n_grid, b_off_average(b2, np.array(cum)))
     thresholds = {name: threshold_velocity(v, f) for name, (v, f) in curves.items()}
     write_csv(campaign / "summary.csv", table)
-    summary = dict(runs=len(outcomes), table=table, v_fra=thresholds)
+    summary = dict(runs=len(outcomes), left_out=left_out, include_cap=include_cap, table=table,
+                   v_fra=thresholds)
     if plot:
         pictures = plots.growth_efficiency(campaign / "growth_efficiency", dict(curves), thresholds)
         pictures += plots.cumulative(campaign / "cumulative", cumulative)

@@ -61,8 +61,9 @@ def iter_local(path) -> Iterator[tuple[int, np.ndarray]]:
             line = f.readline()
             while line and not line.startswith("ITEM: ENTRIES"):
                 line = f.readline()                  # box bounds
+            columns = len(line.split()) - 2              # after "ITEM: ENTRIES"
             rows = [f.readline().split() for _ in range(n)]
-            yield step, np.array(rows, dtype=float).reshape(n, -1)
+            yield step, np.array(rows, dtype=float).reshape(n, columns)
             line = f.readline()
 
 

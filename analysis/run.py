@@ -15,19 +15,34 @@ from pathlib import Path
 import numpy as np
 
 from jkrdt.materials import from_dict, scales
+from jkrdt.stopping import ENERGY_WARN
 
 from . import fragments as frag
 from .dumps import frames
 from .outcome import energy_scalings, measure_frame
 from .plots import energy_partition, snapshot
+from .status import run_status
 from .tables import write_csv, write_json
 from .thermo import CHANNELS, energy_budget, read_thermo
 
 
-def analyse_run(run, tolerance: float | None = None, plots: bool = True) -> dict:
+class RunNotComplete(ValueError):
+    """A run that failed or was cut off, analysed without ``partial=True``."""
+
+
+def analyse_run(run, tolerance: float | None = None, plots: bool = True,
+                partial: bool = False) -> dict:
     """Analyse ``run``; returns what ``outcome.json`` holds. ``tolerance`` (m, default
-    delta_c) is used only when the run has no contact dump."""
+    delta_c) is used only when the run has no contact dump. A run that failed or was
+    cut off (see ``analysis.status``) raises ``RunNotComplete`` unless ``partial``, which
+    analyses the frames there are and records the stop reason."""
     run = Path(run)
+    if not (run / "collision.json").exists():
+        raise FileNotFoundError(f"{run} has no collision.json: analyse a directory written by "
+                                "'jkrdt setup' (or jkrdt.collision.write) and run there")
+    status = run_status(run)
+    if status.stop_reason == "error" and not partial:
+        raise RunNotComplete(f"{run}: {status.problem}; analyse what is there with --partial")
     meta = json.loads((run / "collision.json").read_text())
     mat = from_dict(meta["material"])
     s = scales(mat, meta["radius"])
@@ -50,8 +65,12 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True) -> dict
         rows.append(row)
         last = frame, labels, result
     if last is None:
-        raise ValueError(f"{run / 'atoms.dump'} has no frames")
+        raise ValueError(f"{run / 'atoms.dump'} has no frames"
+                         + (f" ({status.problem})" if status.problem else ""))
     frame, labels, final = last
+    status = run_status(run, last_dump_step=frame.step)
+    if status.problem and not partial:
+        raise RunNotComplete(f"{run}: {status.problem}; analyse what is there with --partial")
     n_k = n_tar + n_pro - 2
     sizes, cumulative = frag.cumulative_number(labels)
     out = dict(run=str(run), N_tar=n_tar, N_pro=n_pro, v_col=meta["v_col"],
@@ -63,9 +82,17 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True) -> dict
                **final.__dict__, fragment_sizes=sizes.tolist(), N_cum=cumulative.tolist(),
                contacts_source="contact list" if frame.pairs is not None else
                f"positions, r_i + r_j + {tolerance:.3e} m")
+    out.update(stop_reason=status.stop_reason, stop_step=status.stop_step,
+               last_step=frame.step, settled=status.stop_reason == "settled",
+               problem=status.problem)
     if budget is not None:
         e_imp = meta["E_imp"]
-        out.update(energy_error=float(np.abs(budget["total"] - budget["total"][0]).max() / e_imp),
+        upto = thermo["Step"] <= frame.step
+        at = np.flatnonzero(thermo["Step"] == frame.step)
+        left = budget["kinetic"][at[0]] if at.size else budget["kinetic"][upto][-1]
+        error = float(np.abs(budget["total"] - budget["total"][0]).max() / e_imp)
+        out.update(kinetic_left=float(left / e_imp), energy_error=error,
+                   energy_warning=error > ENERGY_WARN,
                    dissipated_fraction=float(budget["dissipated"][-1] / e_imp),
                    dissipated_by_channel={name: float(budget[name][-1] / e_imp)
                                           for name in CHANNELS})
@@ -96,11 +123,23 @@ def summary_text(out: dict) -> str:
         + (f" = {out['E_imp_over_nk_Eroll']:.3g} n_k E_roll" if out['E_imp_over_nk_Eroll'] else "")
         + f" = {out['E_imp_over_nk_Ebreak']:.3g} n_k E_break",
     ]
+    ended = {"settled": "settled", "cap": "hit the cap before settling",
+             "steps": "ran its fixed number of steps (no settle rule)",
+             "error": "FAILED", "cut off": "was CUT OFF"}[out["stop_reason"]]
+    lines.append(f"run ended                   {ended} at step {out['stop_step']}"
+                 + (f" (analysed up to step {out['last_step']})"
+                    if out["last_step"] != out["stop_step"] else ""))
+    if out.get("problem"):
+        lines.append(f"  WARNING                   {out['problem']}; partial outcome")
+    if "kinetic_left" in out:
+        lines.append(f"kinetic energy left / E_imp {out['kinetic_left']:.3f}")
     if "dissipated_fraction" in out:
         lines.append(f"dissipated / E_imp          {out['dissipated_fraction']:.3f}  ("
                      + ", ".join(f"{k} {v:.3f}" for k, v in out["dissipated_by_channel"].items())
                      + ")")
-        lines.append(f"max |dE| / E_imp            {out['energy_error']:.2e}")
+        lines.append(f"max |dE| / E_imp            {out['energy_error']:.2e}"
+                     + (f"  WARNING: above {ENERGY_WARN:g}; use a smaller --dt"
+                        if out["energy_warning"] else ""))
     for p in out.get("pictures", []):
         if p.endswith(".png"):
             lines.append(f"picture                     {p}")

@@ -2,8 +2,11 @@
 
 #include "fix_jkr_dt_contacts.h"
 
+#include "pair_jkr_dt.h"
+
 #include "atom.h"
 #include "error.h"
+#include "force.h"
 #include "memory.h"
 
 #include <algorithm>
@@ -46,6 +49,16 @@ FixJKRDTContacts::~FixJKRDTContacts()
   memory->destroy(partner);
   memory->destroy(values);
   memory->destroy(ledger);
+}
+
+/* ----------------------------------------------------------------------
+   end of a run: the pair style reports how well the step resolved contacts
+------------------------------------------------------------------------- */
+
+void FixJKRDTContacts::post_run()
+{
+  auto *pair = dynamic_cast<PairJKRDT *>(force->pair_match("jkr/dt", 1, 0));
+  if (pair) pair->report_run();
 }
 
 /* ----------------------------------------------------------------------

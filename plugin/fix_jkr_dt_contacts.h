@@ -40,6 +40,7 @@ class FixJKRDTContacts : public Fix {
   FixJKRDTContacts(class LAMMPS *, int, char **);
   ~FixJKRDTContacts() override;
   int setmask() override { return 0; }
+  void post_run() override;
 
   void set_layout(int mask);
   int layout_mask() const { return mask; }

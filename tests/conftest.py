@@ -33,11 +33,15 @@ ENERGY_THERMO = "step ke c_erot pe c_p[1] c_p[5] c_p[6] c_p[7] c_p[8] c_p[9] c_p
 
 
 def two_grain_scene(lmp, separation, v_rel=0.0, material=ICE, coeff_extra="frictionless",
-                    dt_over_tc=0.01, newton="off", box=2.0e-6):
-    """Two ice grains on the x axis, ``separation`` apart (centre to centre),
-    approaching each other at ``v_rel``. Thermo carries the energy ledger."""
-    r = R_GRAIN
+                    dt_over_tc=0.01, newton="off", box=2.0e-6, radius=R_GRAIN, skin=None,
+                    settings=""):
+    """Two grains of ``radius`` (default 0.1 micron ice) on the x axis, ``separation``
+    apart (centre to centre), approaching each other at ``v_rel``. The neighbor skin
+    is ``skin`` (default 2 delta_c); ``settings`` go on the pair_style line. Thermo
+    carries the energy ledger."""
+    r = radius
     s = scales(material, r)
+    skin = 2 * s.delta_c if skin is None else skin
     lmp.commands_string(f"""
         units si
         atom_style sphere
@@ -54,9 +58,9 @@ def two_grain_scene(lmp, separation, v_rel=0.0, material=ICE, coeff_extra="frict
         velocity all set 0 0 0
         set atom 1 vx {0.5 * v_rel!r}
         set atom 2 vx {-0.5 * v_rel!r}
-        pair_style jkr/dt
+        pair_style jkr/dt {settings}
         pair_coeff * * gamma {material.gamma!r} E {material.E!r} nu {material.nu!r} {coeff_extra}
-        neighbor {2 * s.delta_c!r} bin
+        neighbor {skin!r} bin
         neigh_modify every 1 delay 0 check yes
         fix integrate all nve/sphere
         compute p all pair jkr/dt

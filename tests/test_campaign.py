@@ -15,7 +15,8 @@ from jkrdt.campaign import run_campaign
 
 BIN = Path(sys.executable).parent
 SPEC = dict(kind="bpca", dim=3, n_tar=16, n_pro=16, material="ice", model="frictional",
-            v_col=[2.0, 80.0], b_off2=[0.0, 0.5, 1.0], seeds=[2], steps=4000, every=1000)
+            v_col=[2.0, 80.0], b_off2=[0.0, 0.5, 1.0], seeds=[2],
+            settle=dict(check_tc=10, cap_tc=4000))
 
 
 @pytest.fixture(scope="module")
@@ -34,7 +35,10 @@ def test_every_run_is_analysed(campaign):
     assert len(outcomes) == 6
     for path in outcomes:
         out = json.loads(path.read_text())
-        assert out["step"] == SPEC["steps"] and out["n_total"] == 32
+        # every run ends by the settle rule, on its last dumped frame, below the cap
+        assert out["stop_reason"] == "settled" and out["step"] == out["stop_step"]
+        assert out["stop_step"] * 0.014 < SPEC["settle"]["cap_tc"]
+        assert out["n_total"] == 32
         assert out["growth_efficiency"] == (out["n_largest"] - 16) / 16
         assert out["energy_error"] < 1e-3
 
@@ -93,7 +97,13 @@ def test_spec_errors_name_the_fix(tmp_path):
     spec.write_text(json.dumps(dict(SPEC, b_off2=[0.0, 2.0])))
     with pytest.raises(ValueError, match="must lie in"):
         run_campaign(spec, tmp_path / "runs", progress=False)
-    spec.write_text(json.dumps(dict(SPEC, steps=4500)))
+    spec.write_text(json.dumps(dict(SPEC, settle=False, steps=4500, every=1000)))
     with pytest.raises(ValueError, match="multiple of every"):
+        run_campaign(spec, tmp_path / "runs", progress=False)
+    spec.write_text(json.dumps(dict(SPEC, steps=4000)))
+    with pytest.raises(ValueError, match="go with \"settle\": false"):
+        run_campaign(spec, tmp_path / "runs", progress=False)
+    spec.write_text(json.dumps(dict(SPEC, settle=dict(windows=3))))
+    with pytest.raises(ValueError, match="settle takes"):
         run_campaign(spec, tmp_path / "runs", progress=False)
     assert not (tmp_path / "runs").exists()

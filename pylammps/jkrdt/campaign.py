@@ -6,7 +6,13 @@ A spec (JSON) names the grid and the scene:
     {"kind": "bpca", "dim": 3, "n_tar": 128, "n_pro": 128, "material": "ice",
      "material_overrides": {"tvis": 6e-12}, "radius": 1e-7, "model": "frictional",
      "v_col": [10, 20, 40], "b_off2": [0, 0.25, 0.5, 0.75], "seeds": [1],
-     "steps": 20000, "dt": 0.014, "every": 1000}
+     "dt": 0.014, "settle": {"check_tc": 50, "window": 5, "tolerance": 0.01,
+                             "cap_tc": 40000}}
+
+Each run ends when its collision has settled (``jkrdt.stopping``; "settle" may be
+left out for the defaults, or given in part), or, with ``"settle": false``, after
+``"steps"`` steps, dumped every ``"every"`` steps. A run that fails is recorded with
+``"stop_reason": "error"`` in its outcome.json and is not tried again.
 
 Each run goes to ``CAMPAIGN/v<v_col>/b2_<B_off^2>/seed<seed>``. A run is finished when
 its ``outcome.json`` exists; that file is written last, atomically, so an interrupted
@@ -25,14 +31,17 @@ import numpy as np
 from . import collision
 from .aggregates import bcca, bpca
 from .materials import material, scales
+from .stopping import SettleRule
 
 BUILDERS = {"bpca": bpca, "bcca": bcca}
 DEFAULTS = dict(kind="bpca", dim=3, material="ice", material_overrides={}, radius=1.0e-7,
-                model="frictional", seeds=[1], dt=0.014, every=1000)
-REQUIRED = ["n_tar", "n_pro", "v_col", "b_off2", "steps"]
+                model="frictional", seeds=[1], dt=0.014, settle={}, steps=None, every=None)
+REQUIRED = ["n_tar", "n_pro", "v_col", "b_off2"]
 
 
 def read_spec(path) -> dict:
+    """The spec at ``path`` with defaults filled in; ``spec["settle"]`` becomes a
+    ``SettleRule`` or None (fixed steps)."""
     given = json.loads(Path(path).read_text())
     unknown = sorted(set(given) - set(DEFAULTS) - set(REQUIRED))
     if unknown:
@@ -44,10 +53,38 @@ def read_spec(path) -> dict:
         raise ValueError(f"{path}: the campaign spec lacks {missing}")
     if any(not 0 <= b <= 1 for b in spec["b_off2"]):
         raise ValueError(f"{path}: b_off2 values are B_off^2 and must lie in [0, 1]")
-    if spec["steps"] % spec["every"]:
-        raise ValueError(f"{path}: steps must be a multiple of every, so that the last "
-                         "frame is the end of the run")
+    if spec["settle"] is False:
+        if not (isinstance(spec["steps"], int) and spec["steps"] > 0):
+            raise ValueError(f"{path}: with \"settle\": false give \"steps\" (> 0)")
+        spec["every"] = spec["every"] or max(1, spec["steps"] // 20)
+        if spec["steps"] % spec["every"]:
+            raise ValueError(f"{path}: steps must be a multiple of every, so that the last "
+                             "frame is the end of the run")
+        spec["settle"] = None
+    else:
+        if spec["steps"] is not None or spec["every"] is not None:
+            raise ValueError(f"{path}: \"steps\" and \"every\" go with \"settle\": false; a "
+                             "settling run is capped by settle.cap_tc and dumped at its checks")
+        settle = {} if spec["settle"] is True else spec["settle"]
+        try:
+            spec["settle"] = SettleRule(**settle)
+        except TypeError:
+            raise ValueError(f"{path}: settle takes {sorted(SettleRule.__dataclass_fields__)} "
+                             f"(got {sorted(settle)})") from None
+        except ValueError as err:
+            raise ValueError(f"{path}: {err}") from None
     return spec
+
+
+def record_failure(directory: Path, v: float, b2: float, seed, error: str) -> None:
+    """outcome.json of a run that failed: its parameters and the error, no outcome."""
+    from jkrdt.analysis.tables import write_json
+
+    meta = json.loads((directory / "collision.json").read_text())
+    write_json(directory / "outcome.json",
+               dict(run=str(directory), v_col=v, B_off=float(np.sqrt(b2)), seed=seed,
+                    model=meta.get("model"), N_tar=meta["N_tar"], N_pro=meta["N_pro"],
+                    stop_reason="error", settled=False, problem=error))
 
 
 def run_directory(campaign, v: float, b2: float, seed) -> Path:
@@ -98,11 +135,22 @@ def run_campaign(spec_path, campaign, progress: bool = True) -> dict:
             collision.write(c, mat, directory)
             write_scene_deck(directory)
         comm.Barrier()
-        with Session(directory, directory, dt=spec["dt"], every=spec["every"], comm=comm) as run:
-            run.run(spec["steps"], chunk=spec["every"], progress=False)
-            run.write_restart()
+        failed = None
+        try:
+            with Session(directory, directory, dt=spec["dt"], every=spec["every"] or 1,
+                         comm=comm, settle=spec["settle"]) as run:
+                if spec["settle"] is None:
+                    run.run(spec["steps"], chunk=spec["every"], progress=False)
+                else:
+                    run.run_until_settled(progress=False)
+                run.write_restart()
+        except Exception as err:            # a LAMMPS error: recorded, the campaign goes on
+            failed = str(err).strip().splitlines()[0]
         if comm.rank == 0:
-            analyse_run(directory)
+            if failed is None:
+                analyse_run(directory)
+            else:
+                record_failure(directory, v, b2, seed, failed)
         comm.Barrier()
     bar.close()
     return dict(runs=len(todo), skipped=skipped, ran=len(todo) - skipped)

@@ -28,6 +28,7 @@ from .campaign import BUILDERS
 from .datafile import write_sphere_data
 from .materials import PRESETS, material, scales
 from .session import find_deck, scene_variables, write_scene_deck
+from .stopping import DEFAULT_RULE, ENERGY_WARN, SettleRule
 
 
 def run_lammps(deck: Path, out: Path, variables: dict, nproc: int = 1) -> None:
@@ -113,14 +114,35 @@ def write_scene(kind, n_tar, n_pro, radius, mat, v, b_off, seed, dim, model, out
           f"E_imp = {c.meta['E_imp']:.3e} J; wrote {data}, collision.json and {deck.name}")
 
 
-def run_scene(out: Path, model, dt: float, steps: int, nproc: int) -> None:
-    """Run a scene written by ``write_scene`` with the deck, in its own directory."""
+def run_scene(out: Path, model, dt: float, steps: int | None, nproc: int,
+              rule: SettleRule = DEFAULT_RULE) -> None:
+    """Run a scene written by ``write_scene`` with the deck, in its own directory: until
+    it settles by ``rule`` (the cap included), or ``steps`` steps when given."""
+    from jkrdt.analysis.status import run_status
+    from jkrdt.analysis.thermo import energy_budget, read_thermo
+
     variables = scene_variables(out, model, dt)
-    variables.update(out=out, steps=steps, every=output_interval(steps))
+    variables["out"] = out
+    if steps is None:
+        variables.update(rule.deck_variables(dt))
+    else:
+        variables.update(settle="no", steps=steps, every=output_interval(steps))
+    for stale in ("atoms.dump", "contacts.dump", "log.lammps"):
+        (out / stale).unlink(missing_ok=True)
     t0 = time.time()
     run_lammps(find_deck(), out, variables, nproc=nproc)
-    print(f"ran {steps} steps ({variables['model']}) in {time.time() - t0:.1f} s on "
-          f"{nproc} rank(s); log, dumps and restarts in {out}")
+    status = run_status(out)
+    budget = energy_budget(read_thermo(out / "log.lammps"))
+    e_imp = json.loads((out / "collision.json").read_text())["E_imp"]
+    error = float(np.abs(budget["total"] - budget["total"][0]).max() / e_imp)
+    ended = {"settled": "settled", "cap": "hit the cap without settling",
+             "steps": "ran its steps"}.get(status.stop_reason, status.stop_reason)
+    print(f"{ended} at step {status.stop_step} of at most {variables['steps']} "
+          f"({variables['model']}, dt = {dt:g} t_c) in {time.time() - t0:.1f} s on {nproc} "
+          f"rank(s); max |dE| / E_imp = {error:.2e}; log, dumps and restarts in {out}")
+    if error > ENERGY_WARN:
+        print(f"jkrdt: WARNING: max |dE| / E_imp = {error:.2e} exceeds {ENERGY_WARN:g}: reduce "
+              "--dt (see 'Choosing the time step' in the README)", file=sys.stderr)
 
 
 def setup(args) -> int:
@@ -129,8 +151,39 @@ def setup(args) -> int:
     return 0
 
 
+def settle_rule(args) -> SettleRule:
+    """The settle rule of --check, --window, --settle-tol and --cap."""
+    try:
+        return SettleRule(check_tc=args.check, window=args.window, tolerance=args.settle_tol,
+                          cap_tc=args.cap)
+    except ValueError as err:
+        raise SystemExit(f"jkrdt: {err}") from None
+
+
+def add_settle_options(p) -> None:
+    d = DEFAULT_RULE
+    p.add_argument("--steps", type=int, default=None,
+                   help="run exactly this many steps instead of until the collision settles")
+    p.add_argument("--cap", type=float, default=d.cap_tc,
+                   help="simulated time at which an unsettled run stops, in t_c "
+                        "(default %(default)g)")
+    p.add_argument("--check", type=float, default=d.check_tc,
+                   help="time between settle checks and dumps, in t_c (default %(default)g)")
+    p.add_argument("--window", type=int, default=d.window,
+                   help="checks over which fragments, contacts and dissipation must hold "
+                        "still (default %(default)d)")
+    p.add_argument("--settle-tol", type=float, default=d.tolerance,
+                   help="allowed relative change of the contact count and of the dissipated "
+                        "energy over the window (default %(default)g)")
+
+
 def run(args) -> int:
-    run_scene(Path(args.dir).resolve(), args.model, args.dt, args.steps, args.np)
+    if not args.dt > 0:
+        raise SystemExit(f"jkrdt: --dt must be > 0 (in units of t_c; got {args.dt})")
+    if args.steps is not None and args.steps < 1:
+        raise SystemExit(f"jkrdt: --steps must be >= 1 (got {args.steps})")
+    run_scene(Path(args.dir).resolve(), args.model, args.dt, args.steps, args.np,
+              settle_rule(args))
     return 0
 
 
@@ -140,7 +193,7 @@ def demo(args) -> int:
     out = Path(args.out).resolve()
     write_scene("bpca", args.n, args.n, 1.0e-7, material("ice"), args.v, args.b_off, args.seed,
                 3, args.model, out)
-    run_scene(out, args.model, 0.014, args.steps, args.np)
+    run_scene(out, args.model, 0.014, args.steps, args.np, settle_rule(args))
     print()
     print(summary_text(analyse_run(out)))
     print(f"tables                      {out / 'frames.csv'}, {out / 'outcome.json'}")
@@ -150,7 +203,13 @@ def demo(args) -> int:
 def analyse(args) -> int:
     from jkrdt.analysis.run import analyse_run, summary_text
 
-    out = analyse_run(args.dir, tolerance=args.tolerance, plots=not args.no_plots)
+    from jkrdt.analysis.run import RunNotComplete
+
+    try:
+        out = analyse_run(args.dir, tolerance=args.tolerance, plots=not args.no_plots,
+                          partial=args.partial)
+    except (RunNotComplete, FileNotFoundError) as err:
+        raise SystemExit(f"jkrdt: {err}") from None
     print(summary_text(out))
     return 0
 
@@ -166,10 +225,19 @@ def campaign(args) -> int:
 def summarise(args) -> int:
     from jkrdt.analysis.campaign import summarise as summarise_campaign
 
-    summary = summarise_campaign(args.dir, plot=not args.no_plots)
+    try:
+        summary = summarise_campaign(args.dir, plot=not args.no_plots,
+                                     include_cap=args.include_cap)
+    except ValueError as err:
+        raise SystemExit(f"jkrdt: {err}") from None
     for row in summary["table"]:
         print(f"{row['model']:<40} v_col {row['v_col']:7.3g} m/s  <f_gro> {row['mean_f_gro']:+.3f}"
-              f"  ({row['runs']} runs)")
+              f"  ({row['runs']} runs" + (f", {row['left_out']} left out" if row["left_out"]
+                                         else "")
+              + (f", {row['capped']} hit the cap" if row["capped"] else "") + ")")
+    for gone in summary["left_out"]:
+        print(f"left out ({gone['stop_reason']}): {gone['run']}"
+              + (f": {gone['problem']}" if gone.get("problem") else ""))
     for model, v in summary["v_fra"].items():
         print(f"v_fra ({model}): " + (f"{v:.3g} m/s" if v else "no crossing of <f_gro> = 0"))
     for p in summary.get("pictures", []):
@@ -185,7 +253,7 @@ def main(argv=None) -> int:
     d.add_argument("--n", type=int, default=500, help="grains per aggregate")
     d.add_argument("--v", type=float, default=20.0, help="collision speed, m/s")
     d.add_argument("--b-off", type=float, default=0.3, help="impact parameter B_off")
-    d.add_argument("--steps", type=int, default=40000)
+    add_settle_options(d)
     d.add_argument("--np", type=int, default=1, help="MPI ranks")
     d.add_argument("--model", choices=["frictional", "frictionless"], default="frictional",
                    help="Wada et al. (2007) with sliding, rolling, twisting (xi_crit = 8 A), "
@@ -212,7 +280,7 @@ def main(argv=None) -> int:
     add_material_options(bd)
     rn = sub.add_parser("run", help="run a scene written by 'jkrdt setup'")
     rn.add_argument("dir", help="directory with collision.data and collision.json")
-    rn.add_argument("--steps", type=int, default=20000)
+    add_settle_options(rn)
     rn.add_argument("--dt", type=float, default=0.014, help="time step in units of t_c")
     rn.add_argument("--model", choices=["frictional", "frictionless"], default=None,
                     help="default: the model in collision.json")
@@ -224,6 +292,8 @@ def main(argv=None) -> int:
                     help="position tolerance on r_i + r_j when the run has no contact dump, "
                          "m (default delta_c)")
     an.add_argument("--no-plots", action="store_true")
+    an.add_argument("--partial", action="store_true",
+                    help="analyse a run that failed or was cut off, as far as its dumps go")
     cp = sub.add_parser("campaign", help="run a grid of collisions from a JSON spec "
                         "(resumes: finished runs are skipped)")
     cp.add_argument("spec")
@@ -233,6 +303,8 @@ def main(argv=None) -> int:
                         "runs.csv, summary.csv, summary.json, plots")
     sm.add_argument("dir")
     sm.add_argument("--no-plots", action="store_true")
+    sm.add_argument("--include-cap", action="store_true",
+                    help="average in the runs that hit the settle cap (left out by default)")
     args = parser.parse_args(argv)
     return {"demo": demo, "build": build, "setup": setup, "run": run, "analyse": analyse,
             "campaign": campaign, "summarise": summarise}[args.command](args)

