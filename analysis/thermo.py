@@ -8,6 +8,8 @@ import numpy as np
 
 LEDGER = ["c_p[5]", "c_p[6]", "c_p[7]", "c_p[8]", "c_p[9]"]   # dissipated, by channel
 CHANNELS = ["events", "damping", "sliding", "rolling", "twisting"]  # the order of LEDGER
+#: the conserved total as a LAMMPS equal-style formula over the deck's computes p, erot
+CONSERVED = "ke+c_erot+pe+" + "+".join(LEDGER)
 
 
 def read_thermo(log) -> dict[str, np.ndarray]:

@@ -28,7 +28,8 @@ import numpy as np
 from jkrdt.aggregates import bpca
 from jkrdt.datafile import write_sphere_data
 from jkrdt.materials import ICE, QUARTZ, scales
-from jkrdt.session import start_lammps
+from jkrdt.session import read_deck, start_lammps
+from jkrdt.analysis.thermo import CONSERVED
 
 KICK = 0.01          # initial kinetic energy per grain, in F_c delta_c
 RATIOS = [0.05, 0.1, 0.2, 0.3, 0.35, 0.4, 0.45, 0.5, 0.6, 0.7, 0.8, 1.0, 1.2, 1.5]
@@ -50,24 +51,10 @@ def resting_run(mat, model: str, ratio: float, n: int, steps: int, seed: int = 1
         write_sphere_data(data, x, r, mat.density, v=v, omega=omega)
         lmp = start_lammps()
         try:
-            lmp.commands_string(f"""
-                units si
-                atom_style sphere
-                atom_modify map array
-                comm_modify vel yes
-                read_data {data}
-                pair_style jkr/dt dt_check off
-                pair_coeff * * gamma {mat.gamma!r} E {mat.E!r} nu {mat.nu!r} {words}
-                neighbor {10 * s.delta_c!r} bin
-                neigh_modify every 1 delay 0 check yes
-                fix integrate all nve/sphere
-                compute p all pair jkr/dt
-                compute erot all erotate/sphere
-                variable total equal ke+c_erot+pe+c_p[5]+c_p[6]+c_p[7]+c_p[8]+c_p[9]
-                thermo_style custom step ke pe v_total
-                timestep {ratio * s.t_c!r}
-                run 0 post no
-            """)
+            read_deck(lmp, dict(file=data, gamma=mat.gamma, E=mat.E, nu=mat.nu, model=words,
+                                dt=ratio * s.t_c, skin=10 * s.delta_c, dt_check="off"))
+            lmp.command(f"variable total equal {CONSERVED}")
+            lmp.command("run 0 post no")
             e0 = lmp.extract_variable("total")
             k0 = lmp.get_thermo("ke") + float(lmp.extract_compute("erot", 0, 0))
             worst, blown, chunk = 0.0, None, max(1, steps // 100)

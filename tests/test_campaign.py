@@ -107,3 +107,15 @@ def test_spec_errors_name_the_fix(tmp_path):
     with pytest.raises(ValueError, match="settle takes"):
         run_campaign(spec, tmp_path / "runs", progress=False)
     assert not (tmp_path / "runs").exists()
+
+
+def test_failed_run_is_recorded_and_left_out_of_the_summary(tmp_path):
+    spec = tmp_path / "spec.json"
+    spec.write_text(json.dumps(dict(SPEC, v_col=[20.0], b_off2=[0.0], dt=0.6)))
+    assert run_campaign(spec, tmp_path / "runs", progress=False)["ran"] == 1
+    out = json.loads(next((tmp_path / "runs").rglob("outcome.json")).read_text())
+    assert out["stop_reason"] == "error" and "above 0.4 t_c" in out["problem"]
+    # finished as far as resuming goes: not tried again
+    assert run_campaign(spec, tmp_path / "runs", progress=False)["skipped"] == 1
+    with pytest.raises(ValueError, match=r"none of its 1 runs is complete \(\['error'\]\)"):
+        summarise(tmp_path / "runs", plot=False)

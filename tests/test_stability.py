@@ -17,7 +17,8 @@ from conftest import R_GRAIN, ledger, two_grain_scene
 from jkrdt.aggregates import bpca
 from jkrdt.datafile import write_sphere_data
 from jkrdt.materials import ICE, QUARTZ, scales
-from jkrdt.session import start_lammps
+from jkrdt.analysis.thermo import CONSERVED
+from jkrdt.session import read_deck, start_lammps
 
 V_STICK = 1.9345      # v0
 
@@ -214,23 +215,9 @@ def test_resting_aggregate_drift_stays_bounded_over_a_million_steps(tmp_path):
     write_sphere_data(tmp_path / "a.data", x, r, ICE.density, v=v)
     lmp = start_lammps()
     try:
-        lmp.commands_string(f"""
-            units si
-            atom_style sphere
-            atom_modify map array
-            comm_modify vel yes
-            read_data {tmp_path / 'a.data'}
-            pair_style jkr/dt
-            pair_coeff * * gamma 0.1 E 7e9 nu 0.25 xi_crit 8e-10
-            neighbor 1e-8 bin
-            fix integrate all nve/sphere
-            compute p all pair jkr/dt
-            compute erot all erotate/sphere
-            variable total equal ke+c_erot+pe+c_p[5]+c_p[6]+c_p[7]+c_p[8]+c_p[9]
-            thermo_style custom step ke pe v_total
-            timestep {0.014 * s.t_c!r}
-            run 0 post no
-        """)
+        read_deck(lmp, dict(file=tmp_path / "a.data", dt=0.014 * s.t_c))    # ice, frictional
+        lmp.command(f"variable total equal {CONSERVED}")
+        lmp.command("run 0 post no")
         e0 = lmp.extract_variable("total")
         k0 = lmp.get_thermo("ke")
         error = []

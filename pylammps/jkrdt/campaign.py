@@ -81,9 +81,11 @@ def record_failure(directory: Path, v: float, b2: float, seed, error: str) -> No
     from jkrdt.analysis.tables import write_json
 
     meta = json.loads((directory / "collision.json").read_text())
+    mat = meta["material"]
     write_json(directory / "outcome.json",
                dict(run=str(directory), v_col=v, B_off=float(np.sqrt(b2)), seed=seed,
-                    model=meta.get("model"), N_tar=meta["N_tar"], N_pro=meta["N_pro"],
+                    model=meta.get("model"), material=mat["name"], xi_crit=mat["xi_crit"],
+                    tvis=mat["tvis"], N_tar=meta["N_tar"], N_pro=meta["N_pro"],
                     stop_reason="error", settled=False, problem=error))
 
 

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import collision
+from . import collision, timestep
 from .aggregates import bonds, gyration_radius
 from .campaign import BUILDERS
 from .datafile import write_sphere_data
@@ -96,9 +96,23 @@ def build(args) -> int:
     return 0
 
 
-def write_scene(kind, n_tar, n_pro, radius, mat, v, b_off, seed, dim, model, out):
-    """Build target and projectile, set up their collision and write the scene into ``out``."""
+def write_scene(kind, n_tar, n_pro, radius, mat, v, b_off, seed, dim, model, out,
+                dt: float | str | None = None, tolerance: float = 1e-4):
+    """Build target and projectile, set up their collision and write the scene into ``out``
+    (emptied of an earlier run's outputs). ``dt`` (t_c, or 'auto' for ``tolerance``)
+    becomes the scene's time step."""
     s = scales(mat, radius)
+    if dt == "auto":
+        try:
+            dt, reason = timestep.choose(tolerance, v, s.v0)
+        except ValueError as err:
+            raise SystemExit(f"jkrdt: {err}") from None
+    elif dt is not None:
+        reason = f"dt = {dt:g} t_c given to jkrdt setup"
+    out = Path(out)
+    for stale in ("atoms.dump", "contacts.dump", "log.lammps", "frames.csv", "outcome.json",
+                  "restart.a", "restart.b", "final.restart", "final.dump"):
+        (out / stale).unlink(missing_ok=True)
     rng = np.random.default_rng(seed)
     build = BUILDERS[kind]
     t0 = time.time()
@@ -108,13 +122,16 @@ def write_scene(kind, n_tar, n_pro, radius, mat, v, b_off, seed, dim, model, out
     c = collision.set_up(tar, pro, radius, v_col=v, b_off=b_off, rng=rng, material=mat,
                          dim=dim, seed=seed)
     c.meta.update(kind=kind, model=model, build_seconds=built)
+    if dt is not None:
+        c.meta.update(dt_over_tc=dt, dt_reason=reason)
     data = collision.write(c, mat, out)
     deck = write_scene_deck(out)
     print(f"{kind.upper()} {n_tar} + {n_pro} ({dim}D, {mat.name}) built in {built:.1f} s; "
-          f"E_imp = {c.meta['E_imp']:.3e} J; wrote {data}, collision.json and {deck.name}")
+          f"E_imp = {c.meta['E_imp']:.3e} J; wrote {data}, collision.json and {deck.name}"
+          + (f"\n{reason}" if dt is not None else ""))
 
 
-def run_scene(out: Path, model, dt: float, steps: int | None, nproc: int,
+def run_scene(out: Path, model, dt: float | None, steps: int | None, nproc: int,
               rule: SettleRule = DEFAULT_RULE) -> None:
     """Run a scene written by ``write_scene`` with the deck, in its own directory: until
     it settles by ``rule`` (the cap included), or ``steps`` steps when given."""
@@ -123,6 +140,7 @@ def run_scene(out: Path, model, dt: float, steps: int | None, nproc: int,
 
     variables = scene_variables(out, model, dt)
     variables["out"] = out
+    dt = variables["dt_over_tc"]
     if steps is None:
         variables.update(rule.deck_variables(dt))
     else:
@@ -146,9 +164,22 @@ def run_scene(out: Path, model, dt: float, steps: int | None, nproc: int,
 
 
 def setup(args) -> int:
+    if not args.v > 0:
+        raise SystemExit(f"jkrdt: --v is the collision speed and must be > 0 m/s (got {args.v})")
+    if not 0 <= args.b_off <= 1:
+        raise SystemExit(f"jkrdt: --b-off must lie in [0, 1] (got {args.b_off})")
     write_scene(args.kind, args.n_tar, args.n_pro, args.radius, chosen_material(args), args.v,
-                args.b_off, args.seed, args.dim, args.model, args.out)
+                args.b_off, args.seed, args.dim, args.model, args.out, dt=args.dt,
+                tolerance=args.tolerance)
     return 0
+
+
+def time_step(value: str):
+    """argparse type of --dt: a number of t_c, or 'auto'."""
+    try:
+        return timestep.parse(value)
+    except ValueError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
 
 
 def settle_rule(args) -> SettleRule:
@@ -178,8 +209,9 @@ def add_settle_options(p) -> None:
 
 
 def run(args) -> int:
-    if not args.dt > 0:
-        raise SystemExit(f"jkrdt: --dt must be > 0 (in units of t_c; got {args.dt})")
+    if args.dt == "auto":
+        raise SystemExit("jkrdt: --dt auto belongs to jkrdt setup (it is written into the "
+                         "scene); jkrdt run takes a number of t_c or the scene's dt")
     if args.steps is not None and args.steps < 1:
         raise SystemExit(f"jkrdt: --steps must be >= 1 (got {args.steps})")
     run_scene(Path(args.dir).resolve(), args.model, args.dt, args.steps, args.np,
@@ -193,7 +225,7 @@ def demo(args) -> int:
     out = Path(args.out).resolve()
     write_scene("bpca", args.n, args.n, 1.0e-7, material("ice"), args.v, args.b_off, args.seed,
                 3, args.model, out)
-    run_scene(out, args.model, 0.014, args.steps, args.np, settle_rule(args))
+    run_scene(out, args.model, None, args.steps, args.np, settle_rule(args))
     print()
     print(summary_text(analyse_run(out)))
     print(f"tables                      {out / 'frames.csv'}, {out / 'outcome.json'}")
@@ -270,6 +302,11 @@ def main(argv=None) -> int:
     add_material_options(st)
     st.add_argument("--model", choices=["frictional", "frictionless"], default="frictional")
     st.add_argument("--seed", type=int, default=1)
+    st.add_argument("--dt", type=time_step, default=None,
+                    help="the scene's time step in units of t_c, or 'auto' to choose it from "
+                         "--tolerance and the impact speed (default: 0.014, the papers')")
+    st.add_argument("--tolerance", type=float, default=1e-4,
+                    help="max |dE| / E_imp that --dt auto aims at (default %(default)g)")
     st.add_argument("--out", default="runs/scene")
     bd = sub.add_parser("build", help="build one aggregate and write it as a data file")
     bd.add_argument("--kind", choices=list(BUILDERS), default="bpca")
@@ -281,7 +318,8 @@ def main(argv=None) -> int:
     rn = sub.add_parser("run", help="run a scene written by 'jkrdt setup'")
     rn.add_argument("dir", help="directory with collision.data and collision.json")
     add_settle_options(rn)
-    rn.add_argument("--dt", type=float, default=0.014, help="time step in units of t_c")
+    rn.add_argument("--dt", type=time_step, default=None,
+                    help="time step in units of t_c (default: the scene's, else 0.014)")
     rn.add_argument("--model", choices=["frictional", "frictionless"], default=None,
                     help="default: the model in collision.json")
     rn.add_argument("--np", type=int, default=1, help="MPI ranks")

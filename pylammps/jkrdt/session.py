@@ -22,6 +22,7 @@ import numpy as np
 
 from .materials import from_dict, scales
 from .stopping import ENERGY_WARN, SettleRule
+from .timestep import PAPER_DT
 
 #: thermo columns sampled after each chunk; the names of the deck's thermo output
 THERMO = ["Step", "Time", "KinEng", "c_erot", "PotEng",
@@ -74,6 +75,15 @@ def find_deck(name: str = "collision.lmp") -> Path:
                             "or run from the repository root")
 
 
+def read_deck(lmp, variables: dict) -> None:
+    """Set up ``lmp`` with ``inputs/collision.lmp`` and ``variables`` (``run=no`` by default:
+    the deck stops before its run; ``outputs=no`` and ``settle=no`` unless given)."""
+    variables = dict(dict(run="no", outputs="no", settle="no"), **variables)
+    for name, value in variables.items():
+        lmp.command(f'variable {name} index "{value}"')
+    lmp.file(str(find_deck()))
+
+
 def model_words(model: str, mat) -> str:
     """pair_coeff words of a model of the 3D BPCA paper: 'frictional' (Wada et al.
     2007 with the material's xi_crit) or 'frictionless'."""
@@ -86,9 +96,23 @@ def model_words(model: str, mat) -> str:
     return f"xi_crit {mat.xi_crit!r}"
 
 
-def scene_variables(scene, model: str | None = None, dt: float = 0.014) -> dict:
+def scene_dt(meta: dict, dt: float | None = None) -> tuple[float, str]:
+    """(dt / t_c, why): ``dt`` if given, else the scene's own (``jkrdt setup --dt``),
+    else the papers' 0.014 t_c."""
+    if dt is not None:
+        if not dt > 0:
+            raise ValueError(f"dt must be > 0 (in units of t_c; got {dt})")
+        return dt, f"dt = {dt:g} t_c given for this run"
+    if "dt_over_tc" in meta:
+        return meta["dt_over_tc"], meta.get("dt_reason", "the scene's dt")
+    return PAPER_DT, f"dt = {PAPER_DT} t_c, the papers' choice (Wada et al. 2007, sec. 4)"
+
+
+def scene_variables(scene, model: str | None = None, dt: float | None = None) -> dict:
     """Variables of ``inputs/collision.lmp`` for a scene directory written by
-    ``jkrdt setup`` (``collision.data`` + ``collision.json``); ``dt`` in units of t_c."""
+    ``jkrdt setup`` (``collision.data`` + ``collision.json``); ``dt`` in units of t_c
+    (default: the scene's, see ``scene_dt``). ``dt_over_tc`` and ``dt_note`` (why this
+    dt, printed to the log) come along."""
     scene = Path(scene).resolve()
     meta = json.loads((scene / "collision.json").read_text())
     mat = from_dict(meta["material"])
@@ -96,11 +120,13 @@ def scene_variables(scene, model: str | None = None, dt: float = 0.014) -> dict:
     words = model_words(model or meta.get("model", "frictional"), mat)
     if mat.G is not None:
         words += f" G {mat.G!r}"
-    return dict(file=scene / "collision.data", dt=dt * s.t_c, model=words,
-                dim=meta["dimension"], gamma=mat.gamma, E=mat.E, nu=mat.nu, tvis=mat.tvis)
+    ratio, why = scene_dt(meta, dt)
+    return dict(file=scene / "collision.data", dt=ratio * s.t_c, model=words,
+                dim=meta["dimension"], gamma=mat.gamma, E=mat.E, nu=mat.nu, tvis=mat.tvis,
+                dt_over_tc=ratio, dt_note=why.replace('"', "'"))
 
 
-def write_scene_deck(scene, model: str | None = None, dt: float = 0.014) -> Path:
+def write_scene_deck(scene, model: str | None = None, dt: float | None = None) -> Path:
     """Write ``in.collision.lmp`` into a scene directory: the scene's variables, then
     ``inputs/collision.lmp`` verbatim (a variable's first definition wins), so that
     ``cd scene && lmp -in in.collision.lmp`` runs it with no other file."""
@@ -124,7 +150,7 @@ class Session:
     scene : directory written by ``jkrdt setup`` (or ``collision.write``)
     out : directory for the log, and the dumps and restarts when asked for
     model : 'frictional' or 'frictionless'; default the one in collision.json
-    dt : time step in units of t_c
+    dt : time step in units of t_c; default the scene's (``jkrdt setup --dt``), else 0.014
     every : dump and restart interval in steps; 0 writes no dumps or restarts
     restart : a restart file to continue from instead of the scene's data file
     comm : mpi4py communicator (default COMM_WORLD)
@@ -136,7 +162,7 @@ class Session:
     ...     s.energies()["total"]
     """
 
-    def __init__(self, scene, out=None, model: str | None = None, dt: float = 0.014,
+    def __init__(self, scene, out=None, model: str | None = None, dt: float | None = None,
                  every: int = 0, restart=None, comm=None, screen: bool = False,
                  settle: SettleRule | None = None):
         MPI = _load_mpi()
@@ -149,18 +175,17 @@ class Session:
         self.settle = settle
         self.stop_reason: str | None = None
         variables = scene_variables(scene, model, dt)
+        self.dt_over_tc = variables["dt_over_tc"]
         variables.update(out=self.out, every=every or 1000, outputs="yes" if every else "no",
                          run="no", settle="no")
         if settle is not None:          # dumps, if any, at the settle checks
-            variables.update(settle.deck_variables(dt))
+            variables.update(settle.deck_variables(self.dt_over_tc))
         self.check = int(variables["every"])
         self.cap = int(variables["steps"]) if settle is not None else None
         if restart is not None:
             variables.update(read="read_restart", file=Path(restart).resolve())
         self.lmp = start_lammps(self.comm, log=self.out / "log.lammps", screen=screen)
-        for name, value in variables.items():
-            self.lmp.command(f'variable {name} index "{value}"')
-        self.lmp.file(str(find_deck()))
+        read_deck(self.lmp, variables)
         self._rows: list[list[float]] = []
         self.lmp.command("run 0 post no")    # forces and energies of the initial state
         self._sample()

@@ -1,0 +1,66 @@
+"""The time step of a scene: given in units of t_c, or chosen from an energy tolerance.
+
+t_c = sqrt(m delta_c / F_c) (Wada et al. 2007, eq. 49) is the time a contact takes to
+move by delta_c at v0; the plugin prints it at every run and refuses dt > 0.4 t_c
+(benchmarks/stability.py). Within the stable range the energy error of a collision
+grows as a power of dt and of the impact speed; ``benchmarks/tradeoff.py`` measures
+it on ensembles of 2D and 3D collisions and writes the fit
+
+    max |dE| / E_imp  <=  C (dt / t_c)^p (v_col / v0)^q
+
+to ``timestep_fit.json`` (the worst run of each ensemble lies on or below it).
+``choose`` inverts it for a tolerance; the choice is held to [DT_MIN, DT_MAX] t_c.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+#: the papers' time step (Wada et al. 2007, sec. 4): |dE| / E_imp below 1e-4
+PAPER_DT = 0.014
+DT_MIN, DT_MAX = 0.002, 0.1      # t_c; above DT_MAX the plugin warns
+FIT_FILE = Path(__file__).with_name("timestep_fit.json")
+
+
+def fit() -> dict:
+    """The study's fit (``benchmarks/tradeoff.py``)."""
+    return json.loads(FIT_FILE.read_text())
+
+
+def predicted_error(dt_over_tc: float, v_over_v0: float) -> float:
+    f = fit()
+    return 10 ** (f["log10_C"] + f["p"] * math.log10(dt_over_tc)
+                  + f["q"] * math.log10(v_over_v0))
+
+
+def choose(tolerance: float, v_col: float, v0: float) -> tuple[float, str]:
+    """(dt / t_c, the reason) for a max |dE| / E_imp of ``tolerance`` at ``v_col``."""
+    if not 0 < tolerance < 1:
+        raise ValueError(f"--tolerance is a relative energy error in (0, 1) (got {tolerance})")
+    if not v_col > 0:
+        raise ValueError(f"the impact speed must be > 0 to choose dt (got {v_col})")
+    f = fit()
+    v = v_col / v0
+    dt = 10 ** ((math.log10(tolerance) - f["log10_C"] - f["q"] * math.log10(v)) / f["p"])
+    held = min(max(dt, DT_MIN), DT_MAX)
+    reason = (f"dt = {held:.4g} t_c chosen for max |dE|/E_imp <= {tolerance:g} at v_col = "
+              f"{v_col:g} m/s = {v:.3g} v0 from the fit {10 ** f['log10_C']:.3g} (dt/t_c)^"
+              f"{f['p']:.2f} (v/v0)^{f['q']:.2f} of benchmarks/tradeoff")
+    if held != dt:
+        reason += f" (the fit gave {dt:.3g} t_c, held to [{DT_MIN}, {DT_MAX}])"
+    return held, reason
+
+
+def parse(value: str) -> float | str:
+    """A --dt value: a number of t_c, or 'auto'."""
+    if value == "auto":
+        return value
+    try:
+        dt = float(value)
+    except ValueError:
+        raise ValueError(f"--dt takes a time step in units of t_c or 'auto' (got {value!r})")
+    if not dt > 0:
+        raise ValueError(f"--dt must be > 0 (in units of t_c; got {value})")
+    return dt
