@@ -33,6 +33,9 @@ FixJKRDTContacts::FixJKRDTContacts(LAMMPS *lmp, int narg, char **arg) :
   peratom_flag = 1;
   size_peratom_cols = NLEDGER;
   peratom_freq = 1;
+  scalar_flag = 1;
+  global_freq = 1;
+  extscalar = 0;
 
   grow_arrays(atom->nmax);
   atom->add_callback(Atom::GROW);

@@ -12,6 +12,9 @@
    pair (the atom with the smaller ID is "particle 1"), so both copies are
    identical.
 
+   The fix's global scalar is the number of doubles stored per contact under
+   the current layout (0 for the frictionless model).
+
    Each atom also keeps a ledger of the energy dissipated in its contacts,
    one column per channel; half of each contact's dissipation goes to each of
    its two atoms. The ledger sums to the dissipated energies of
@@ -41,6 +44,7 @@ class FixJKRDTContacts : public Fix {
   ~FixJKRDTContacts() override;
   int setmask() override { return 0; }
   void post_run() override;
+  double compute_scalar() override { return dnum; }    // doubles stored per contact
 
   void set_layout(int mask);
   int layout_mask() const { return mask; }

@@ -26,6 +26,7 @@
 
 #include "atom.h"
 #include "comm.h"
+#include "domain.h"
 #include "error.h"
 #include "memory.h"
 #include "utils.h"
@@ -208,6 +209,9 @@ PairJKRDT::Param PairJKRDT::resolve(int i, int j) const
   P.sliding = channel(ij.sliding, ii.sliding, jj.sliding);
   P.rolling = channel(ij.rolling, ii.rolling, jj.rolling);
   P.twisting = channel(ij.twisting, ii.twisting, jj.twisting);
+  // in 2D omega lies along z and n_c in the plane: the twisting angle of eq. (24) stays 0,
+  // so the channel is off and its angle is not stored
+  if (domain->dimension == 2) P.twisting = 0;
 
   if (P.rolling && std::isnan(P.xi_crit))
     error->all(FLERR,

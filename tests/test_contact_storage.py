@@ -59,3 +59,39 @@ def test_twelve_contacts_on_one_grain(lmp):
     assert set(rows[:, 0]) == {1} and sorted(rows[:, 1]) == list(range(2, 14))
     assert np.allclose(rows[:, 2], S.delta0, rtol=1e-9)
     assert np.allclose(rows[:, 3], S.a0, rtol=1e-9)
+
+
+def doubles_per_contact(lmp, coeff, dim=3):
+    """The contact fix's global scalar after a run 0 of two bonded ice grains."""
+    lmp.commands_string(f"""
+        units si
+        dimension {dim}
+        atom_style sphere
+        boundary f f {'p' if dim == 2 else 'f'}
+        comm_modify vel yes
+        region box block -1e-6 1e-6 -1e-6 1e-6 -1e-6 1e-6
+        create_box 1 box
+        create_atoms 1 single 0 0 0
+        create_atoms 1 single {2 * R_GRAIN - S.delta0!r} 0 0
+        set type 1 diameter {2 * R_GRAIN!r}
+        set type 1 density {ICE.density!r}
+        pair_style jkr/dt
+        pair_coeff * * gamma 0.1 E 7e9 nu 0.25 {coeff}
+        neighbor 1e-8 bin
+        fix nve all nve/sphere
+        {'fix plane all enforce2d' if dim == 2 else ''}
+        timestep 1e-12
+        run 0
+    """)
+    return lmp.extract_fix("JKR_DT_CONTACTS", 0, 0)
+
+
+@pytest.mark.parametrize("coeff, dim, doubles", [
+    ("xi_crit 8e-10", 3, 7),                 # pointers n1, n2 and the twisting angle
+    ("xi_crit 8e-10 tvis 6e-12", 3, 8),      # ... and the damping force of eq. (A.5)
+    ("frictionless", 3, 0),                  # nothing: the JKR normal force has no history
+    ("frictionless tvis 6e-12", 3, 1),
+    ("xi_crit 8e-10", 2, 6),                 # 2D: no twist, so no twisting angle
+])
+def test_a_scene_stores_only_what_its_model_needs(lmp, coeff, dim, doubles):
+    assert doubles_per_contact(lmp, coeff, dim) == doubles

@@ -1,0 +1,53 @@
+"""The time step chosen from an energy tolerance (jkrdt setup --dt auto) keeps its promise
+on a real collision, and says in the scene and the log why it was chosen."""
+
+import json
+import math
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from jkrdt import timestep
+from jkrdt.analysis.thermo import energy_budget, read_thermo
+from jkrdt.materials import ICE, scales
+
+BIN = Path(sys.executable).parent
+V0 = scales(ICE, 1e-7).v0
+
+
+@pytest.mark.parametrize("tolerance, v", [(1e-4, 10.0), (1e-3, 40.0), (3e-5, 20.0)])
+def test_choice_inverts_the_fit(tolerance, v):
+    dt, reason = timestep.choose(tolerance, v, V0)
+    if timestep.DT_MIN < dt < timestep.DT_MAX:
+        assert timestep.predicted_error(dt, v / V0) == pytest.approx(tolerance, rel=1e-9)
+    assert f"max |dE|/E_imp <= {tolerance:g}" in reason
+
+
+def test_choice_is_held_to_the_range_that_was_measured():
+    dt, reason = timestep.choose(0.5, 20.0, V0)
+    assert dt == timestep.DT_MAX and "held to" in reason
+    with pytest.raises(ValueError, match="--tolerance is a relative energy error"):
+        timestep.choose(0.0, 20.0, V0)
+
+
+def test_auto_dt_meets_its_tolerance_on_a_collision(tmp_path):
+    scene = tmp_path / "scene"
+    subprocess.run([str(BIN / "jkrdt"), "setup", "--kind", "bcca", "--dim", "2", "--n-tar", "32",
+                    "--n-pro", "32", "--v", "10", "--seed", "6", "--dt", "auto", "--tolerance",
+                    "1e-4", "--out", str(scene)], check=True, timeout=120, capture_output=True)
+    meta = json.loads((scene / "collision.json").read_text())
+    dt, _ = timestep.choose(1e-4, 10.0, V0)
+    assert meta["dt_over_tc"] == pytest.approx(dt, rel=1e-12)
+    subprocess.run([str(BIN / "jkrdt"), "run", str(scene), "--check", "20", "--cap", "4000"],
+                   check=True, timeout=300, capture_output=True)
+    log = (scene / "log.lammps").read_text()
+    ratio = float(re.search(r"pair jkr/dt: t_c = \S+ .*timestep \S+ = (\S+) t_c", log).group(1))
+    assert ratio == pytest.approx(dt, rel=1e-3)
+    assert "chosen for max |dE|/E_imp <= 0.0001" in log
+    budget = energy_budget(read_thermo(scene / "log.lammps"))
+    error = abs(budget["total"] - budget["total"][0]).max() / meta["E_imp"]
+    assert error <= 1e-4
+    assert math.isfinite(error)
