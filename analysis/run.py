@@ -91,6 +91,8 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
         at = np.flatnonzero(thermo["Step"] == frame.step)
         left = budget["kinetic"][at[0]] if at.size else budget["kinetic"][upto][-1]
         error = float(np.abs(budget["total"] - budget["total"][0]).max() / e_imp)
+        t_end = float(thermo["Time"][at[0]] if at.size else thermo["Time"][upto][-1])
+        out.update(time_end=t_end, time_end_over_tc=t_end / s.t_c)
         out.update(kinetic_left=float(left / e_imp), energy_error=error,
                    energy_warning=error > ENERGY_WARN,
                    dissipated_fraction=float(budget["dissipated"][-1] / e_imp),
@@ -100,8 +102,12 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
     if plots:
         title = (f"{mat.name} {(meta.get('kind') or '').upper()} {n_tar}+{n_pro}, "
                  f"v = {meta['v_col']:g} m/s, B_off = {meta['B_off']:g}, {meta.get('model', '')}")
-        out["pictures"] = [str(p) for p in snapshot(run / "outcome", frame.x, labels, title,
-                                                           radius=meta["radius"])]
+        when = f"{status.stop_reason} at step {frame.step}"
+        if "time_end" in out:
+            when += (f", t = {out['time_end'] * 1e9:.0f} ns = {out['time_end_over_tc']:.0f} t_c; "
+                     f"max |dE|/E_imp = {out['energy_error']:.1e}")
+        out["pictures"] = [str(p) for p in snapshot(run / "outcome", frame.x, labels,
+                                                    f"{title}\n{when}", radius=meta["radius"])]
         if budget is not None:
             out["pictures"] += [str(p) for p in energy_partition(run / "energy", thermo["Time"],
                                                                  budget, meta["E_imp"], title)]
@@ -128,7 +134,9 @@ def summary_text(out: dict) -> str:
              "error": "FAILED", "cut off": "was CUT OFF"}[out["stop_reason"]]
     lines.append(f"run ended                   {ended} at step {out['stop_step']}"
                  + (f" (analysed up to step {out['last_step']})"
-                    if out["last_step"] != out["stop_step"] else ""))
+                    if out["last_step"] != out["stop_step"] else "")
+                 + (f", t = {out['time_end'] * 1e9:.0f} ns = {out['time_end_over_tc']:.0f} t_c"
+                    if "time_end" in out else ""))
     if out.get("problem"):
         lines.append(f"  WARNING                   {out['problem']}; partial outcome")
     if "kinetic_left" in out:

@@ -201,7 +201,8 @@ class Session:
 
     def run(self, steps: int, chunk: int | None = None, progress: bool = True) -> dict:
         """Advance ``steps`` steps in chunks of ``chunk`` (default steps/100), sampling the
-        energies after each; returns all samples so far as ``thermo()`` does."""
+        energies after each; returns all samples so far as ``thermo()`` does. With a
+        settle rule the run ends early, at the check where the collision settled."""
         if steps < 0:
             raise ValueError("steps must be >= 0")
         chunk = max(1, steps // 100) if chunk is None else int(chunk)
