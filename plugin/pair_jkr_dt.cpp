@@ -108,6 +108,7 @@ void PairJKRDT::init_style()
     }
   check_periodic_images(cutmax);
   check_neighbor_settings();
+  check_integrator();
   find_contact_time();
 
   neighbor->add_request(this, NeighConst::REQ_NEWTON_OFF);

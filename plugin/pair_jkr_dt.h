@@ -123,6 +123,7 @@ class PairJKRDT : public Pair {
   void find_max_radii();
   void check_periodic_images(double cutmax);
   void check_neighbor_settings() const;
+  void check_integrator() const;
   void find_contact_time();
   void check_time_step();
   void check_initial_overlap(int p, int q, double delta, const JKRDT::NormalScales &S) const;

@@ -31,9 +31,11 @@
 #include "memory.h"
 #include "utils.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
+#include <vector>
 
 using namespace LAMMPS_NS;
 
@@ -94,10 +96,25 @@ void PairJKRDT::coeff(int narg, char **arg)
 
   Input g = NOTHING_GIVEN;
   int iarg = 2;
+  static const std::vector<std::string> keywords = {
+      "gamma",   "E",       "nu",       "G",        "xi_crit",  "tvis",    "sliding",
+      "rolling", "twisting", "frictionless", "ks_scale", "kr_scale", "kt_scale"};
+  auto is_keyword = [&](const char *word) {
+    return std::find(keywords.begin(), keywords.end(), word) != keywords.end();
+  };
   auto value = [&](const std::string &key) -> const char * {
-    if (iarg + 1 >= narg)
-      error->all(FLERR, "pair_coeff for jkr/dt: keyword '{}' needs a value", key);
+    if (iarg + 1 >= narg || is_keyword(arg[iarg + 1]))
+      error->all(FLERR, "pair_coeff for jkr/dt: keyword '{}' needs a value{}", key,
+                 iarg + 1 < narg ? fmt::format(" (next is the keyword '{}')", arg[iarg + 1])
+                                 : std::string(" (the line ends)"));
     return arg[iarg + 1];
+  };
+  auto on_off = [&](const std::string &key) {
+    const std::string word = value(key);
+    if (word == "on" || word == "yes" || word == "true") return 1;
+    if (word == "off" || word == "no" || word == "false") return 0;
+    error->all(FLERR, "pair_coeff for jkr/dt: {} takes on or off (got '{}')", key, word);
+    return 0;
   };
   auto positive = [&](const std::string &key) {
     const double x = utils::numeric(FLERR, value(key), false, lmp);
@@ -131,11 +148,11 @@ void PairJKRDT::coeff(int narg, char **arg)
         error->all(FLERR, "pair_coeff for jkr/dt: tvis must be >= 0; 0 means no damping (got {})",
                    g.tvis);
     } else if (key == "sliding") {
-      g.sliding = utils::logical(FLERR, value(key), false, lmp);
+      g.sliding = on_off(key);
     } else if (key == "rolling") {
-      g.rolling = utils::logical(FLERR, value(key), false, lmp);
+      g.rolling = on_off(key);
     } else if (key == "twisting") {
-      g.twisting = utils::logical(FLERR, value(key), false, lmp);
+      g.twisting = on_off(key);
     } else if (key == "frictionless") {
       g.sliding = g.rolling = g.twisting = 0;
       iarg += 1;
@@ -157,11 +174,14 @@ void PairJKRDT::coeff(int narg, char **arg)
   int count = 0;
   for (int i = ilo; i <= ihi; i++)
     for (int j = std::max(jlo, i); j <= jhi; j++) {
-      if (i == j && !(given(g.gamma) && given(g.E)))
+      if (i == j && !(given(g.gamma) && given(g.E))) {
+        std::string missing = given(g.gamma) ? "" : "gamma";
+        if (!given(g.E)) missing += missing.empty() ? "E and nu" : ", E and nu";
         error->all(FLERR,
-                   "pair_coeff {} {} for jkr/dt: a type's own line must give its material: "
-                   "gamma, E and nu",
-                   i, j);
+                   "pair_coeff {} {} for jkr/dt: a type's own line must give its material; "
+                   "missing: {}",
+                   i, j, missing);
+      }
       in(i, j) = g;
       setflag[i][j] = 1;
       count++;

@@ -18,6 +18,8 @@
 #include "atom.h"
 #include "comm.h"
 #include "error.h"
+#include "fix.h"
+#include "modify.h"
 #include "neigh_list.h"
 #include "neighbor.h"
 #include "update.h"
@@ -82,6 +84,33 @@ void PairJKRDT::check_neighbor_settings() const
                "step it should break. Set a skin of a few delta_c or more, e.g. 'neighbor 1.0e-8 "
                "bin' for 0.1 micron grains in SI units",
                neighbor->skin);
+}
+
+/* ----------------------------------------------------------------------
+   velocity Verlet is what the energy ledger books against (the trapezoid
+   of each load over a step); rRESPA splits the step and breaks that, and
+   an integrator without rotation leaves the torques unused
+------------------------------------------------------------------------- */
+
+void PairJKRDT::check_integrator() const
+{
+  if (utils::strmatch(update->integrate_style, "^respa"))
+    error->all(FLERR,
+               "pair jkr/dt does not support run_style {}: the energy ledger books against one "
+               "velocity-Verlet step. Use 'run_style verlet' with 'fix nve/sphere'",
+               update->integrate_style);
+  bool integrated = false, rotates = false;
+  for (const auto *fix : modify->get_fix_list()) {
+    if (!fix->time_integrate) continue;
+    integrated = true;
+    if (utils::strmatch(fix->style, "sphere") || utils::strmatch(fix->style, "^rigid"))
+      rotates = true;
+  }
+  if (integrated && !rotates && comm->me == 0)
+    error->warning(FLERR,
+                   "pair jkr/dt: no time-integration fix turns the grains (fix nve/sphere): the "
+                   "sliding, rolling and twisting torques act on frozen spins. Use 'fix ID all "
+                   "nve/sphere'");
 }
 
 /* ----------------------------------------------------------------------

@@ -55,7 +55,9 @@ def test_ghost_velocities_missing():
 
 
 def test_type_material_incomplete():
-    expect_error("gamma, E and nu", coeff="pair_coeff * * gamma 0.1 frictionless")
+    expect_error("must give its material; missing: E and nu",
+                 coeff="pair_coeff * * gamma 0.1 frictionless")
+    expect_error(r"missing: gamma \(", coeff="pair_coeff * * E 7e9 nu 0.25 frictionless")
 
 
 def test_e_without_nu():
@@ -136,3 +138,31 @@ def test_switching_friction_on_mid_run_starts_the_pointers_at_the_contact():
         pair_coeff * * gamma 0.1 E 7e9 nu 0.25 xi_crit 8e-10
         run 0
     """, check=zero_displacements)
+
+
+@pytest.mark.parametrize("coeff, match", [
+    ("pair_coeff * * gamma E 7e9 nu 0.25 frictionless",
+     r"keyword 'gamma' needs a value \(next is the keyword 'E'\)"),
+    ("pair_coeff * * gamma 0.1 E 7e9 nu 0.25 xi_crit 8e-10 sliding maybe",
+     "sliding takes on or off \\(got 'maybe'\\)"),
+])
+def test_coefficient_errors_name_the_keyword(coeff, match):
+    expect_error(match, coeff=coeff)
+
+
+def test_respa_is_refused_with_the_supported_style_named():
+    expect_error("does not support run_style respa.*'run_style verlet' with 'fix nve/sphere'",
+                 tail="run_style respa 2 2\nfix nve all nve/sphere\nrun 1")
+
+
+def test_integration_without_rotation_warns(tmp_path):
+    log = tmp_path / "log.lammps"
+    lmp = start_lammps(log=log)
+    try:
+        lmp.commands_string(BASE.format(style="sphere", comm="comm_modify vel yes",
+                                        coeff=GOOD_COEFF, diameter="set type 1 diameter 2e-7",
+                                        boundary="f f f"))
+        lmp.commands_string("fix move all nve\ntimestep 1e-12\nrun 10")
+    finally:
+        lmp.close()
+    assert "WARNING: pair jkr/dt: no time-integration fix turns the grains" in log.read_text()

@@ -39,6 +39,48 @@ DEFAULTS = dict(kind="bpca", dim=3, material="ice", material_overrides={}, radiu
 REQUIRED = ["n_tar", "n_pro", "v_col", "b_off2"]
 
 
+def _number(x) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
+def _whole(x) -> bool:
+    return isinstance(x, int) and not isinstance(x, bool)
+
+
+#: each key's test and what it must be, for the errors of check_types
+CHECKS = {
+    "n_tar": (lambda x: _whole(x) and x >= 1, "a whole number of grains >= 1"),
+    "n_pro": (lambda x: _whole(x) and x >= 1, "a whole number of grains >= 1"),
+    "v_col": (lambda x: isinstance(x, list) and x and all(_number(v) and v > 0 for v in x),
+              "a non-empty list of speeds > 0 in m/s, e.g. [10, 20]"),
+    "b_off2": (lambda x: isinstance(x, list) and x and all(_number(b) for b in x),
+               "a non-empty list of B_off^2 values in [0, 1], e.g. [0, 0.5, 1]"),
+    "seeds": (lambda x: isinstance(x, list) and x and all(_whole(k) for k in x),
+              "a non-empty list of whole numbers, e.g. [1, 2]"),
+    "kind": (lambda x: x in BUILDERS, f"one of {sorted(BUILDERS)}"),
+    "dim": (lambda x: x in (2, 3) and _whole(x), "2 or 3"),
+    "radius": (lambda x: _number(x) and x > 0, "a grain radius > 0 in m"),
+    "model": (lambda x: x in ("frictional", "frictionless"), "'frictional' or 'frictionless'"),
+    "material_overrides": (lambda x: isinstance(x, dict), "an object of Material fields"),
+    "dt": (lambda x: _number(x) and x > 0, "a time step > 0 in units of t_c"),
+    "steps": (lambda x: x is None or (_whole(x) and x >= 1), "a whole number of steps >= 1"),
+    "every": (lambda x: x is None or (_whole(x) and x >= 1), "a whole number of steps >= 1"),
+    "settle": (lambda x: isinstance(x, (bool, dict)), "true, false or an object of SettleRule "
+               "fields"),
+}
+
+
+def check_types(path, spec: dict) -> None:
+    """Every key of ``spec`` of the type and range it must have, or a ValueError naming it."""
+    for key, (ok, what) in CHECKS.items():
+        if not ok(spec[key]):
+            raise ValueError(f"{path}: \"{key}\" must be {what} (got {spec[key]!r})")
+    try:
+        material(spec["material"], **spec["material_overrides"])
+    except (TypeError, ValueError) as err:
+        raise ValueError(f"{path}: \"material\"/\"material_overrides\": {err}") from None
+
+
 def read_spec(path) -> dict:
     """The spec at ``path`` with defaults filled in; ``spec["settle"]`` becomes a
     ``SettleRule`` or None (fixed steps)."""
@@ -51,12 +93,14 @@ def read_spec(path) -> dict:
     missing = [k for k in REQUIRED if k not in spec]
     if missing:
         raise ValueError(f"{path}: the campaign spec lacks {missing}")
+    check_types(path, spec)
     if any(not 0 <= b <= 1 for b in spec["b_off2"]):
         raise ValueError(f"{path}: b_off2 values are B_off^2 and must lie in [0, 1]")
     if spec["settle"] is False:
         if not (isinstance(spec["steps"], int) and spec["steps"] > 0):
             raise ValueError(f"{path}: with \"settle\": false give \"steps\" (> 0)")
-        spec["every"] = spec["every"] or max(1, spec["steps"] // 20)
+        if spec["every"] is None:
+            spec["every"] = max(1, spec["steps"] // 20)
         if spec["steps"] % spec["every"]:
             raise ValueError(f"{path}: steps must be a multiple of every, so that the last "
                              "frame is the end of the run")

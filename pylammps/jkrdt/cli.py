@@ -41,8 +41,9 @@ def run_lammps(deck: Path, out: Path, variables: dict, nproc: int = 1) -> None:
     done = subprocess.run(cmd, cwd=out)
     if done.returncode != 0:
         log = (out / "log.lammps").read_text().splitlines() if (out / "log.lammps").exists() else []
-        errors = [line for line in log if "ERROR" in line] or log[-5:]
-        raise SystemExit("LAMMPS failed:\n" + "\n".join(errors) + f"\n(full log: {out / 'log.lammps'})")
+        errors = [line.strip() for line in log if "ERROR" in line] or [
+            f"exit status {done.returncode}"]
+        raise SystemExit(f"jkrdt: LAMMPS stopped: {errors[-1]} (full log: {out / 'log.lammps'})")
 
 
 def output_interval(steps: int) -> int:
@@ -96,11 +97,26 @@ def build(args) -> int:
     return 0
 
 
+#: what a scene directory holds once set up, run and analysed: all that --force clears
+SCENE_FILES = ("collision.data", "collision.json", "in.collision.lmp", "atoms.dump",
+               "contacts.dump", "log.lammps", "frames.csv", "outcome.json", "outcome.png",
+               "outcome.pdf", "energy.png", "energy.pdf", "restart.a", "restart.b",
+               "final.restart", "final.dump")
+
+
 def write_scene(kind, n_tar, n_pro, radius, mat, v, b_off, seed, dim, model, out,
-                dt: float | str | None = None, tolerance: float = 1e-4):
-    """Build target and projectile, set up their collision and write the scene into ``out``
-    (emptied of an earlier run's outputs). ``dt`` (t_c, or 'auto' for ``tolerance``)
-    becomes the scene's time step."""
+                dt: float | str | None = None, tolerance: float = 1e-4, force: bool = False):
+    """Build target and projectile, set up their collision and write the scene into ``out``,
+    which must be empty unless ``force`` (then the files of an earlier scene and its run
+    are removed, and nothing else). ``dt`` (t_c, or 'auto' for ``tolerance``) becomes the
+    scene's time step."""
+    out = Path(out)
+    if out.is_dir() and any(out.iterdir()):
+        if not force:
+            raise SystemExit(f"jkrdt: {out} is not empty; choose another --out, or give --force "
+                             "to replace the scene and run outputs there")
+        for name in SCENE_FILES:
+            (out / name).unlink(missing_ok=True)
     s = scales(mat, radius)
     if dt == "auto":
         try:
@@ -109,10 +125,6 @@ def write_scene(kind, n_tar, n_pro, radius, mat, v, b_off, seed, dim, model, out
             raise SystemExit(f"jkrdt: {err}") from None
     elif dt is not None:
         reason = f"dt = {dt:g} t_c given to jkrdt setup"
-    out = Path(out)
-    for stale in ("atoms.dump", "contacts.dump", "log.lammps", "frames.csv", "outcome.json",
-                  "restart.a", "restart.b", "final.restart", "final.dump"):
-        (out / stale).unlink(missing_ok=True)
     rng = np.random.default_rng(seed)
     build = BUILDERS[kind]
     t0 = time.time()
@@ -170,7 +182,7 @@ def setup(args) -> int:
         raise SystemExit(f"jkrdt: --b-off must lie in [0, 1] (got {args.b_off})")
     write_scene(args.kind, args.n_tar, args.n_pro, args.radius, chosen_material(args), args.v,
                 args.b_off, args.seed, args.dim, args.model, args.out, dt=args.dt,
-                tolerance=args.tolerance)
+                tolerance=args.tolerance, force=args.force)
     return 0
 
 
@@ -224,7 +236,7 @@ def demo(args) -> int:
 
     out = Path(args.out).resolve()
     write_scene("bpca", args.n, args.n, 1.0e-7, material("ice"), args.v, args.b_off, args.seed,
-                3, args.model, out)
+                3, args.model, out, force=True)    # the demo's directory is its own
     run_scene(out, args.model, None, args.steps, args.np, settle_rule(args))
     print()
     print(summary_text(analyse_run(out)))
@@ -278,8 +290,15 @@ def summarise(args) -> int:
     return 0
 
 
+class ArgumentParser(argparse.ArgumentParser):
+    """argparse with its errors in one line, ``jkrdt: <what> (<how to fix>)``, status 2."""
+
+    def error(self, message):
+        self.exit(2, f"jkrdt: {message} (see '{self.prog} --help')\n")
+
+
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="jkrdt", description=__doc__)
+    parser = ArgumentParser(prog="jkrdt", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
     d = sub.add_parser("demo", help="collide two BPCA ice aggregates and report the outcome")
     d.add_argument("--n", type=int, default=500, help="grains per aggregate")
@@ -305,6 +324,8 @@ def main(argv=None) -> int:
     st.add_argument("--dt", type=time_step, default=None,
                     help="the scene's time step in units of t_c, or 'auto' to choose it from "
                          "--tolerance and the impact speed (default: 0.014, the papers')")
+    st.add_argument("--force", action="store_true",
+                    help="write into a non-empty --out, replacing an earlier scene and its run")
     st.add_argument("--tolerance", type=float, default=1e-4,
                     help="max |dE| / E_imp that --dt auto aims at (default %(default)g)")
     st.add_argument("--out", default="runs/scene")
@@ -343,9 +364,24 @@ def main(argv=None) -> int:
     sm.add_argument("--no-plots", action="store_true")
     sm.add_argument("--include-cap", action="store_true",
                     help="average in the runs that hit the settle cap (left out by default)")
+    parser.add_argument("--debug", action="store_true",
+                        help="show the Python traceback of an error instead of one line")
     args = parser.parse_args(argv)
-    return {"demo": demo, "build": build, "setup": setup, "run": run, "analyse": analyse,
-            "campaign": campaign, "summarise": summarise}[args.command](args)
+    command = {"demo": demo, "build": build, "setup": setup, "run": run, "analyse": analyse,
+               "campaign": campaign, "summarise": summarise}[args.command]
+    try:
+        return command(args)
+    except SystemExit as stop:           # the commands' own one-line errors
+        if not isinstance(stop.code, str):
+            raise
+        print(stop.code, file=sys.stderr)
+        return 2
+    except (ValueError, FileNotFoundError, RuntimeError) as err:
+        if args.debug:
+            raise
+        message = " ".join(str(err).split())
+        print(f"jkrdt: {message} (jkrdt --debug {args.command} ... shows where)", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":
