@@ -56,7 +56,7 @@ PairJKRDT::PairJKRDT(LAMMPS *lmp) :
     Pair(lmp), fix_contacts(nullptr), visited(nullptr), nmax_visited(0), nstride(0),
     dt_check(DT_CHECK_ERROR), tc_min(0.0), tc_types{0, 0}, tc_logged(0.0), dt_logged(0.0),
     dt_warned(0.0), checked_laststep(-1), step_max(0.0),
-    step_warned(false)
+    step_warned(false), contacts_at_run_end(0), data_contacts(0)
 {
   single_enable = 0;
   restartinfo = 1;
@@ -109,6 +109,7 @@ void PairJKRDT::init_style()
   check_periodic_images(cutmax);
   check_neighbor_settings();
   check_integrator();
+  check_data_file_contacts();
   find_contact_time();
 
   neighbor->add_request(this, NeighConst::REQ_NEWTON_OFF);

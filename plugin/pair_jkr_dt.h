@@ -15,6 +15,7 @@
 #include "jkr_dt_normal.h"
 #include "jkr_dt_tangential.h"
 
+#include <string>
 #include <vector>
 
 namespace LAMMPS_NS {
@@ -80,6 +81,7 @@ class PairJKRDT : public Pair {
   void read_restart(FILE *) override;
   void write_restart_settings(FILE *) override;
   void read_restart_settings(FILE *) override;
+  void write_data(FILE *) override;
   void write_data_all(FILE *) override;
   double memory_usage() override;
 
@@ -102,6 +104,8 @@ class PairJKRDT : public Pair {
   bigint checked_laststep;     // the run whose time step was checked
   double step_max;             // largest |v_n| dt / delta_c of a contact this run, this rank
   bool step_warned;            // the warning of report_run() is given once
+  bigint contacts_at_run_end;  // bonded contacts when the last run ended (write_data marks it)
+  bigint data_contacts;        // contacts a data file read by read_data left behind
   FixJKRDTContacts *fix_contacts;
   int *visited;                // bonded contacts of each local atom seen this step
   int nmax_visited;
@@ -124,6 +128,9 @@ class PairJKRDT : public Pair {
   void check_periodic_images(double cutmax);
   void check_neighbor_settings() const;
   void check_integrator() const;
+  void check_data_file_contacts() const;
+  std::string coeff_words(const Input &g) const;
+  void warn_data_file() const;
   void find_contact_time();
   void check_time_step();
   void check_initial_overlap(int p, int q, double delta, const JKRDT::NormalScales &S) const;

@@ -95,10 +95,11 @@ void PairJKRDT::coeff(int narg, char **arg)
   utils::bounds(FLERR, arg[1], 1, atom->ntypes, jlo, jhi, error);
 
   Input g = NOTHING_GIVEN;
+  bigint marked = 0;
   int iarg = 2;
   static const std::vector<std::string> keywords = {
       "gamma",   "E",       "nu",       "G",        "xi_crit",  "tvis",    "sliding",
-      "rolling", "twisting", "frictionless", "ks_scale", "kr_scale", "kt_scale"};
+      "rolling", "twisting", "frictionless", "ks_scale", "kr_scale", "kt_scale", "data_contacts"};
   auto is_keyword = [&](const char *word) {
     return std::find(keywords.begin(), keywords.end(), word) != keywords.end();
   };
@@ -157,6 +158,8 @@ void PairJKRDT::coeff(int narg, char **arg)
       g.sliding = g.rolling = g.twisting = 0;
       iarg += 1;
       continue;
+    } else if (key == "data_contacts") {
+      marked = utils::bnumeric(FLERR, value(key), false, lmp);    // written by write_data
     } else {
       error->all(FLERR,
                  "pair_coeff for jkr/dt: unknown keyword '{}'; allowed: gamma E nu G xi_crit "
@@ -187,6 +190,7 @@ void PairJKRDT::coeff(int narg, char **arg)
       count++;
     }
   if (count == 0) error->all(FLERR, "pair_coeff for jkr/dt: no type pair matched {} {}", arg[0], arg[1]);
+  data_contacts = marked;    // a pair_coeff given anew clears a data file's mark
 }
 
 /* ----------------------------------------------------------------------
@@ -312,25 +316,51 @@ void PairJKRDT::read_restart(FILE *fp)
     }
 }
 
+/* ----------------------------------------------------------------------
+   data files: "Pair Coeffs" (write_data's default) holds each type's own
+   line, "PairIJ Coeffs" (write_data ... pair ij) every line given; a file
+   written after a run is marked with the contacts it cannot carry
+------------------------------------------------------------------------- */
+
+std::string PairJKRDT::coeff_words(const Input &g) const
+{
+  std::string line;
+  const std::pair<const char *, double> reals[] = {
+      {"gamma", g.gamma},     {"E", g.E},       {"nu", g.nu},
+      {"G", g.G},             {"xi_crit", g.xi_crit}, {"tvis", g.tvis},
+      {"ks_scale", g.ks_scale}, {"kr_scale", g.kr_scale}, {"kt_scale", g.kt_scale}};
+  for (const auto &kv : reals)
+    if (given(kv.second)) line += fmt::format(" {} {:.17g}", kv.first, kv.second);
+  const std::pair<const char *, int> flags[] = {
+      {"sliding", g.sliding}, {"rolling", g.rolling}, {"twisting", g.twisting}};
+  for (const auto &kv : flags)
+    if (kv.second >= 0) line += fmt::format(" {} {}", kv.first, kv.second ? "on" : "off");
+  if (contacts_at_run_end > 0) line += fmt::format(" data_contacts {}", contacts_at_run_end);
+  return line;
+}
+
+void PairJKRDT::warn_data_file() const
+{
+  if (contacts_at_run_end > 0)
+    error->warning(FLERR,
+                   "pair jkr/dt: write_data does not carry the {} bonded contacts (pointers, "
+                   "twist, damping force, energy ledger); a run that takes its pair coefficients "
+                   "from this file refuses to start. To continue a run, use write_restart / "
+                   "read_restart",
+                   contacts_at_run_end);
+}
+
+void PairJKRDT::write_data(FILE *fp)
+{
+  warn_data_file();
+  for (int i = 1; i <= atom->ntypes; i++)
+    if (setflag[i][i]) fmt::print(fp, "{}{}\n", i, coeff_words(in(i, i)));
+}
+
 void PairJKRDT::write_data_all(FILE *fp)
 {
+  warn_data_file();
   for (int i = 1; i <= atom->ntypes; i++)
-    for (int j = i; j <= atom->ntypes; j++) {
-      if (!setflag[i][j]) continue;
-      const Input &g = in(i, j);
-      std::string line = fmt::format("{} {}", i, j);
-      const std::pair<const char *, double> reals[] = {{"gamma", g.gamma}, {"E", g.E},
-                                                       {"nu", g.nu},       {"G", g.G},
-                                                       {"xi_crit", g.xi_crit}, {"tvis", g.tvis},
-                                                       {"ks_scale", g.ks_scale},
-                                                       {"kr_scale", g.kr_scale},
-                                                       {"kt_scale", g.kt_scale}};
-      for (const auto &kv : reals)
-        if (given(kv.second)) line += fmt::format(" {} {:.17g}", kv.first, kv.second);
-      const std::pair<const char *, int> flags[] = {
-          {"sliding", g.sliding}, {"rolling", g.rolling}, {"twisting", g.twisting}};
-      for (const auto &kv : flags)
-        if (kv.second >= 0) line += fmt::format(" {} {}", kv.first, kv.second ? "on" : "off");
-      fmt::print(fp, "{}\n", line);
-    }
+    for (int j = i; j <= atom->ntypes; j++)
+      if (setflag[i][j]) fmt::print(fp, "{} {}{}\n", i, j, coeff_words(in(i, j)));
 }

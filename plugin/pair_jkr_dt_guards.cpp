@@ -298,6 +298,10 @@ void PairJKRDT::report_run()
   double most = 0.0;
   MPI_Allreduce(&step_max, &most, 1, MPI_DOUBLE, MPI_MAX, world);
   step_max = 0.0;
+  bigint mine = 0;
+  for (int i = 0; i < atom->nlocal; i++) mine += fix_contacts->npartner[i];
+  MPI_Allreduce(&mine, &contacts_at_run_end, 1, MPI_LMP_BIGINT, MPI_SUM, world);
+  contacts_at_run_end /= 2;    // each contact is stored with both of its atoms
   if (step_warned || most <= STEP_WARN) return;
   step_warned = true;
   if (comm->me == 0)
@@ -309,6 +313,24 @@ void PairJKRDT::report_run()
                    "0.09 F_c delta_c). The energy budget still closes; reduce the timestep for "
                    "accurate event losses",
                    most, update->dt, update->dt / tc_min, STEP_WARN, 0.5 * most);
+}
+
+/* ----------------------------------------------------------------------
+   a data file cannot carry contacts (pointers, twist, damping force, the
+   ledger): write_data marks the file with the count of bonded contacts it
+   leaves behind (keyword data_contacts), and a run read from it is refused
+------------------------------------------------------------------------- */
+
+void PairJKRDT::check_data_file_contacts() const
+{
+  if (data_contacts > 0)
+    error->all(FLERR,
+               "pair jkr/dt: this data file was written by write_data from a state with {} "
+               "bonded contacts, which a data file cannot carry (pointers, twist, damping force, "
+               "energy ledger): the run would start with them all broken. Continue from "
+               "write_restart / read_restart instead, or give pair_coeff again to start from the "
+               "positions alone",
+               data_contacts);
 }
 
 /* ----------------------------------------------------------------------

@@ -1,0 +1,97 @@
+"""The contact state across LAMMPS commands between runs: what is carried through, and
+what is refused with the way that works named."""
+
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from conftest import ICE_SCALES as S, R_GRAIN, two_grain_scene
+from jkrdt import collision
+from jkrdt.aggregates import bpca
+from jkrdt.materials import ICE
+from jkrdt.session import start_lammps, write_scene_deck
+
+BIN = Path(sys.executable).parent
+READ_BACK = """units si
+atom_style sphere
+comm_modify vel yes
+pair_style jkr/dt
+read_data {data}
+neighbor 1e-8 bin
+fix integrate all nve/sphere
+timestep 3.8e-12
+"""
+
+
+def write_data_after_a_run(tmp_path):
+    log, data = tmp_path / "write.log", tmp_path / "stuck.data"
+    lmp = start_lammps(log=log)
+    try:
+        two_grain_scene(lmp, 2 * R_GRAIN - S.delta0)     # one bonded contact at equilibrium
+        lmp.command("run 10")
+        lmp.command(f"write_data {data}")
+    finally:
+        lmp.close()
+    return log, data
+
+
+def test_write_data_warns_and_a_run_from_it_is_refused(tmp_path):
+    log, data = write_data_after_a_run(tmp_path)
+    assert "WARNING: pair jkr/dt: write_data does not carry the 1 bonded contacts" in \
+        log.read_text()
+    lmp = start_lammps()
+    try:
+        lmp.commands_string(READ_BACK.format(data=data))
+        with pytest.raises(Exception, match="written by write_data from a state with 1 bonded "
+                                            "contacts.*write_restart / read_restart"):
+            lmp.command("run 10")
+    finally:
+        lmp.close()
+
+
+def test_pair_coeff_given_again_starts_from_the_positions(tmp_path):
+    _, data = write_data_after_a_run(tmp_path)
+    lmp = start_lammps()
+    try:
+        lmp.commands_string(READ_BACK.format(data=data))
+        lmp.command("pair_coeff * * gamma 0.1 E 7e9 nu 0.25 frictionless")
+        lmp.command("compute p all pair jkr/dt")
+        lmp.command("run 10")
+        assert lmp.numpy.extract_compute("p", 0, 1)[9] == 1    # the contact formed anew
+    finally:
+        lmp.close()
+
+
+def test_scene_deck_continues_a_restart_with_the_scenes_model_and_dt(tmp_path):
+    # the README's restart route: the scene's own deck, which carries its model and dt
+    rng = np.random.default_rng(21)
+    c = collision.set_up(bpca(40, R_GRAIN, S.delta0, rng), bpca(40, R_GRAIN, S.delta0, rng),
+                         R_GRAIN, v_col=30.0, b_off=0.2, rng=rng, material=ICE, seed=21)
+    c.meta.update(kind="bpca", model="frictionless", dt_over_tc=0.02,
+                  dt_reason="dt = 0.02 t_c given for the test")
+    scene = tmp_path / "scene"
+    collision.write(c, ICE, scene)
+    write_scene_deck(scene)
+    runs = {}
+    for name in ("straight", "first", "second"):
+        runs[name] = tmp_path / name
+        shutil.copytree(scene, runs[name])
+
+    def lmp_in(where, *extra):
+        subprocess.run([str(BIN / "lmp"), "-in", "in.collision.lmp", "-screen", "none",
+                        "-var", "settle", "no", "-var", "every", "1000", *extra], cwd=where,
+                       check=True, timeout=300)
+        final = np.loadtxt(where / "final.dump", skiprows=9)
+        return final[np.argsort(final[:, 0])]
+
+    straight = lmp_in(runs["straight"], "-var", "steps", "4000")
+    lmp_in(runs["first"], "-var", "steps", "2000")
+    second = lmp_in(runs["second"], "-var", "steps", "2000", "-var", "read", "read_restart",
+                    "-var", "file", str(runs["first"] / "final.restart"))
+    assert np.array_equal(straight, second)         # bit for bit
+    log = (runs["second"] / "log.lammps").read_text()
+    assert "timestep 5.472" in log and "= 0.02 t_c" in log and "frictionless" in log
