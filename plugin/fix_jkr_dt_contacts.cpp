@@ -55,6 +55,24 @@ FixJKRDTContacts::~FixJKRDTContacts()
 }
 
 /* ----------------------------------------------------------------------
+   a run without pair jkr/dt would move the atoms under stored contacts
+------------------------------------------------------------------------- */
+
+void FixJKRDTContacts::init()
+{
+  if (force->pair_match("jkr/dt", 1, 0)) return;
+  bigint mine = 0, stored = 0;
+  for (int i = 0; i < atom->nlocal; i++) mine += npartner[i];
+  MPI_Allreduce(&mine, &stored, 1, MPI_LMP_BIGINT, MPI_SUM, world);
+  if (stored > 0)
+    error->all(FLERR,
+               "pair jkr/dt: the pair style is now {}, but {} bonded contacts of jkr/dt are "
+               "stored; a run without jkr/dt would leave them stale. Keep pair_style jkr/dt "
+               "(use pair_style hybrid/overlay to add another), or 'unfix {}' to drop them",
+               force->pair_style ? force->pair_style : "none", stored / 2, id);
+}
+
+/* ----------------------------------------------------------------------
    end of a run: the pair style reports how well the step resolved contacts
 ------------------------------------------------------------------------- */
 

@@ -4,7 +4,9 @@
    as (partner ID, per-contact values). The storage is per atom, so it moves
    with its atom between MPI ranks (pack/unpack_exchange), follows atom
    sorting (copy_arrays) and goes into restart files (pack/unpack_restart).
-   The pair style creates this fix and is the only writer.
+   The pair style creates this fix and is the only writer. The fix outlives
+   a pair_style command that replaces jkr/dt, and then refuses to run while
+   it holds contacts (they would go stale); pair_style jkr/dt takes them back.
 
    Per-contact values are laid out by "fields" that the pair style switches
    on only when some type pair needs them, so a channel that is off stores
@@ -43,6 +45,7 @@ class FixJKRDTContacts : public Fix {
   FixJKRDTContacts(class LAMMPS *, int, char **);
   ~FixJKRDTContacts() override;
   int setmask() override { return 0; }
+  void init() override;
   void post_run() override;
   double compute_scalar() override { return dnum; }    // doubles stored per contact
 

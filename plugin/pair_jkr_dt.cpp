@@ -77,7 +77,9 @@ PairJKRDT::~PairJKRDT()
     memory->destroy(setflag);
     memory->destroy(cutsq);
   }
-  if (fix_contacts && modify->get_fix_by_id(FIX_ID)) modify->delete_fix(FIX_ID);
+  // the contact fix outlives the pair style: a pair_style command that replaces jkr/dt
+  // leaves the contacts in place, and the fix refuses a run without jkr/dt while it
+  // holds any (FixJKRDTContacts::init); pair_style jkr/dt given again takes them back
 }
 
 /* ---------------------------------------------------------------------- */
@@ -115,6 +117,12 @@ void PairJKRDT::init_style()
   neighbor->add_request(this, NeighConst::REQ_NEWTON_OFF);
 
   auto *fix = modify->get_fix_by_id(FIX_ID);
+  if (!fix && fix_contacts && contacts_at_run_end > 0)
+    error->all(FLERR,
+               "pair jkr/dt: its contact fix {} was removed (unfix) with the {} bonded contacts "
+               "it held; the run would start with them all broken. Do not unfix {}; to start "
+               "from the positions alone, give 'pair_style jkr/dt' and 'pair_coeff' anew",
+               FIX_ID, contacts_at_run_end, FIX_ID);
   if (fix) {
     fix_contacts = dynamic_cast<Contacts *>(fix);
     if (!fix_contacts) error->all(FLERR, "fix ID {} is reserved for pair jkr/dt", FIX_ID);

@@ -29,6 +29,7 @@
 #include "domain.h"
 #include "error.h"
 #include "memory.h"
+#include "modify.h"
 #include "utils.h"
 
 #include <algorithm>
@@ -51,6 +52,10 @@ void PairJKRDT::settings(int narg, char **arg)
 {
   // pair_style jkr/dt [dt_check error|warn|off]
   dt_check = DT_CHECK_ERROR;
+  if (fix_contacts && !modify->get_fix_by_id(FIX_ID)) {    // given anew after an unfix
+    fix_contacts = nullptr;
+    contacts_at_run_end = 0;
+  }
   for (int iarg = 0; iarg < narg; iarg += 2) {
     const std::string key = arg[iarg];
     if (key != "dt_check")

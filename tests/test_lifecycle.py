@@ -95,3 +95,45 @@ def test_scene_deck_continues_a_restart_with_the_scenes_model_and_dt(tmp_path):
     assert np.array_equal(straight, second)         # bit for bit
     log = (runs["second"] / "log.lammps").read_text()
     assert "timestep 5.472" in log and "= 0.02 t_c" in log and "frictionless" in log
+
+
+def stuck_pair(lmp):
+    two_grain_scene(lmp, 2 * R_GRAIN - S.delta0)
+    lmp.command("run 10")
+    return lmp
+
+
+def bonded(lmp):
+    return lmp.numpy.extract_compute("p", 0, 1)[9]
+
+
+def test_a_run_under_another_pair_style_is_refused(lmp):
+    stuck_pair(lmp)
+    lmp.command("pair_style zero 1e-7")
+    lmp.command("pair_coeff * *")
+    lmp.command("uncompute p")                     # compute pair jkr/dt would stop it first
+    with pytest.raises(Exception, match=r"pair style is now zero, but 1 bonded contacts of "
+                                        r"jkr/dt are stored.*hybrid/overlay.*unfix"):
+        lmp.command("run 10")
+
+
+def test_pair_style_jkr_dt_given_again_takes_its_contacts_back(lmp):
+    stuck_pair(lmp)
+    lmp.command("pair_style zero 1e-7")
+    lmp.command("pair_style jkr/dt")
+    lmp.command("pair_coeff * * gamma 0.1 E 7e9 nu 0.25 frictionless")
+    lmp.command("run 10")
+    assert bonded(lmp) == 1
+
+
+def test_unfix_of_the_contact_fix_is_refused(lmp):
+    stuck_pair(lmp)
+    lmp.command("unfix JKR_DT_CONTACTS")
+    with pytest.raises(Exception, match=r"contact fix JKR_DT_CONTACTS was removed \(unfix\) "
+                                        r"with the 1 bonded contacts"):
+        lmp.command("run 10")
+    # the way out the error names: the pair style and its coefficients anew
+    lmp.command("pair_style jkr/dt")
+    lmp.command("pair_coeff * * gamma 0.1 E 7e9 nu 0.25 frictionless")
+    lmp.command("run 10")
+    assert bonded(lmp) == 1      # formed again from the positions
