@@ -48,21 +48,31 @@ def atoms_universe(path, columns=("radius", "c_coord")):
                             additional_columns=extra, dt=1.0)
 
 
+class TruncatedDump(ValueError):
+    """A dump whose last snapshot was cut off (the run was killed while writing it)."""
+
+
 def iter_local(path) -> Iterator[tuple[int, np.ndarray]]:
-    """(timestep, rows) of each snapshot of a ``dump local`` file, in file order."""
+    """(timestep, rows) of each snapshot of a ``dump local`` file, in file order; a
+    snapshot cut off by the end of the file raises ``TruncatedDump``."""
     with Path(path).open() as f:
         line = f.readline()
         while line:
             if not line.startswith("ITEM: TIMESTEP"):
                 raise ValueError(f"{path}: expected 'ITEM: TIMESTEP', found {line.strip()!r}")
-            step = int(f.readline())
-            f.readline()                              # ITEM: NUMBER OF ENTRIES
-            n = int(f.readline())
+            try:
+                step = int(f.readline())
+                f.readline()                          # ITEM: NUMBER OF ENTRIES
+                n = int(f.readline())
+            except ValueError:
+                raise TruncatedDump(f"{path}: the last snapshot's header is cut off") from None
             line = f.readline()
             while line and not line.startswith("ITEM: ENTRIES"):
                 line = f.readline()                  # box bounds
             columns = len(line.split()) - 2              # after "ITEM: ENTRIES"
             rows = [f.readline().split() for _ in range(n)]
+            if columns < 1 or any(len(r) != columns for r in rows):
+                raise TruncatedDump(f"{path}: the snapshot of step {step} is cut off")
             yield step, np.array(rows, dtype=float).reshape(n, columns)
             line = f.readline()
 
@@ -88,7 +98,10 @@ class Frame:
 
 def frames(run, atoms="atoms.dump", contacts="contacts.dump") -> Iterator[Frame]:
     """The frames of a run directory: positions and radii from ``atoms``, joined by
-    timestep to the contact list of ``contacts`` when that file exists."""
+    timestep to the contact list of ``contacts`` when that file exists. They end at the
+    last frame both files hold whole (MDAnalysis drops a cut-off last atoms frame; a
+    cut-off contact snapshot ends the frames there), which ``analysis.status`` then
+    reports as a run cut off."""
     run = Path(run)
     u = atoms_universe(run / atoms)
     order = np.argsort(u.atoms.ids)
@@ -101,7 +114,10 @@ def frames(run, atoms="atoms.dump", contacts="contacts.dump") -> Iterator[Frame]
         if local is not None:
             # both dumps are written every N steps; skip contact snapshots the atoms lack
             while pending is None or pending[0] < step:
-                pending = next(local, None)
+                try:
+                    pending = next(local, None)
+                except TruncatedDump:
+                    return                       # the frames end with the last whole snapshot
                 if pending is None:
                     raise ValueError(f"{run / contacts} ends before step {step} of {atoms}")
             if pending[0] != step:

@@ -153,3 +153,18 @@ def test_two_ranks_find_the_fragments_the_analysis_finds(tmp_path):
     sizes = np.bincount(from_contacts(last.ids, last.pairs))
     assert last.step == int(fields["step"])
     assert sizes.max() == int(fields["N_lar"]) and len(sizes) == int(fields["fragments"])
+
+
+@pytest.mark.parametrize("cut", ["atoms.dump", "contacts.dump"])
+def test_truncated_dump_is_refused_unless_partial(settled, tmp_path, cut):
+    d, *_ = settled
+    run = tmp_path / "run"
+    run.mkdir()
+    for name in ("collision.json", "log.lammps", "atoms.dump", "contacts.dump"):
+        (run / name).write_bytes((d / name).read_bytes())
+    data = (run / cut).read_bytes()
+    (run / cut).write_bytes(data[: int(0.97 * len(data))])   # killed while writing
+    with pytest.raises(RunNotComplete, match=r"the dumps end at step \d+, before the run's end"):
+        analyse_run(run, plots=False)
+    out = analyse_run(run, plots=False, partial=True)
+    assert out["stop_reason"] == "cut off" and out["last_step"] < out["stop_step"]
