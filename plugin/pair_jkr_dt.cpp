@@ -103,11 +103,17 @@ void PairJKRDT::init_style()
 
   find_max_radii();
   double cutmax = 0.0;
+  std::vector<Param> fresh(param.size());
   for (int i = 1; i <= atom->ntypes; i++)
     for (int j = i; j <= atom->ntypes; j++) {
-      param[i * nstride + j] = resolve(i, j);
-      cutmax = std::max(cutmax, par(i, j).cut);
+      fresh[i * nstride + j] = fresh[j * nstride + i] = resolve(i, j);
+      cutmax = std::max(cutmax, fresh[i * nstride + j].cut);
     }
+  // a channel that pair_coeff switched off since the last run hands its springs' energy
+  // to its ledger while the old constants are still known
+  auto *held = dynamic_cast<Contacts *>(modify->get_fix_by_id(FIX_ID));
+  if (held && held == fix_contacts) book_channels_switched_off(fresh, *held);
+  param = fresh;
   check_periodic_images(cutmax);
   check_neighbor_settings();
   check_integrator();

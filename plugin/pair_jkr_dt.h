@@ -124,6 +124,7 @@ class PairJKRDT : public Pair {
                        double *state_p, double *state_q, bool formed, bool breaking,
                        const JKRDT::V3 &d12, double dist, JKRDT::ChannelLoad load[JKRDT::NCHANNEL]);
   int layout_mask() const;
+  void book_channels_switched_off(const std::vector<Param> &fresh, FixJKRDTContacts &C);
   void find_max_radii();
   void check_periodic_images(double cutmax);
   void check_neighbor_settings() const;

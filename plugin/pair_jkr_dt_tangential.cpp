@@ -23,6 +23,7 @@
 #include "fix_jkr_dt_contacts.h"
 
 #include "atom.h"
+#include "error.h"
 #include "update.h"
 
 #include <cmath>
@@ -150,4 +151,53 @@ void PairJKRDT::tangential_step(int p, int q, const Param &P, const NormalScales
     write_state(state_p, now);
     write_state(state_q, now);
   }
+}
+
+/* ----------------------------------------------------------------------
+   a channel switched off between runs (pair_coeff ... frictionless): the
+   energy its springs hold, eqs. (11), (21), (25) with the old constants,
+   leaves pe and goes to the channel's ledger, half to each atom of the
+   contact, so that ke + erotate + pe + dissipated stays what it was
+------------------------------------------------------------------------- */
+
+void PairJKRDT::book_channels_switched_off(const std::vector<Param> &fresh, Contacts &C)
+{
+  double **x = atom->x;
+  const tagint *tag = atom->tag;
+  const int *type = atom->type;
+  int unseen = 0;
+  for (int i = 0; i < atom->nlocal; i++)
+    for (int k = 0; k < C.npartner[i]; k++) {
+      const int j = (atom->map_style != Atom::MAP_NONE) ? atom->map(C.partner[i][k]) : -1;
+      if (j < 0) {
+        unseen++;
+        continue;
+      }
+      const Param &before = par(type[i], type[j]);
+      const Param &after = fresh[type[i] * nstride + type[j]];
+      const bool off[NCHANNEL] = {before.sliding && !after.sliding,
+                                  before.rolling && !after.rolling,
+                                  before.twisting && !after.twisting};
+      if (!(off[0] || off[1] || off[2])) continue;
+      ContactState c;
+      if (!read_state(C.contact_values(i, k), c)) continue;    // never traced: no energy
+      const int p = (tag[i] < tag[j]) ? i : j, q = (p == i) ? j : i;
+      const V3 d12 = vec(x[p]) - vec(x[q]);
+      const double dist = norm(d12);
+      const NormalScales S = normal_scales(atom->radius[p], atom->radius[q], before.gamma,
+                                           before.a0_coef);
+      ChannelLoad load[NCHANNEL];
+      tangential_load(c, (1.0 / dist) * d12, dist, atom->radius[p], atom->radius[q], S.R,
+                      tangential_constants(before, S), load);
+      for (int ch = 0; ch < NCHANNEL; ch++)
+        if (off[ch]) C.ledger[i][CHANNEL_LEDGER[ch]] += 0.5 * load[ch].U;
+    }
+  int any = 0;
+  MPI_Allreduce(&unseen, &any, 1, MPI_INT, MPI_SUM, world);
+  if (any)
+    error->all(FLERR,
+               "pair jkr/dt: a channel was switched off, but {} contact partners are not "
+               "found to book the energy its springs hold; add 'atom_modify map array' before "
+               "the box is defined",
+               any);
 }

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import ICE_SCALES as S, R_GRAIN, two_grain_scene
+from conftest import ICE_SCALES as S, R_GRAIN, ledger, two_grain_scene
 from jkrdt import collision
 from jkrdt.aggregates import bpca
 from jkrdt.materials import ICE
@@ -137,3 +137,23 @@ def test_unfix_of_the_contact_fix_is_refused(lmp):
     lmp.command("pair_coeff * * gamma 0.1 E 7e9 nu 0.25 frictionless")
     lmp.command("run 10")
     assert bonded(lmp) == 1      # formed again from the positions
+
+
+@pytest.mark.parametrize("switch", ["frictionless", "xi_crit 8e-10 sliding off",
+                                    "xi_crit 8e-10 twisting off rolling off"])
+def test_switching_a_channel_off_books_its_springs_energy(lmp, switch):
+    # two stuck grains, one spinning about a tilted axis: rolling and twisting springs
+    # load up; switching channels off moves their energy from pe to their ledger
+    two_grain_scene(lmp, 2 * R_GRAIN - S.delta0, coeff_extra="xi_crit 8e-10")
+    lmp.command("set atom 1 omega 2e6 1e6 3e6")
+    lmp.command("run 300 post no")
+    before = ledger(lmp)
+    assert before["p3"] > 0 and before["p4"] > 0            # U_r, U_t held
+    lmp.command(f"pair_coeff * * gamma 0.1 E 7e9 nu 0.25 {switch}")
+    lmp.command("run 0 post no")
+    after = ledger(lmp)
+    assert after["total"] == pytest.approx(before["total"], rel=1e-12, abs=1e-12 * abs(before["pe"]))
+    for slot, ledger_slot in (("p2", "p7"), ("p3", "p8"), ("p4", "p9")):
+        dropped = before[slot] - after[slot]                    # U_s, U_r, U_t that left pe
+        assert after[ledger_slot] - before[ledger_slot] == pytest.approx(dropped, rel=1e-12,
+                                                                         abs=1e-30)
