@@ -5,11 +5,14 @@
 #include "pair_jkr_dt.h"
 
 #include "atom.h"
+#include "comm.h"
 #include "error.h"
 #include "force.h"
 #include "memory.h"
 
 #include <algorithm>
+#include <utility>
+#include <vector>
 #include <cstring>
 
 using namespace LAMMPS_NS;
@@ -20,6 +23,7 @@ static constexpr int INITIAL_CAPACITY = 8;
 
 FixJKRDTContacts::FixJKRDTContacts(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), npartner(nullptr), partner(nullptr), values(nullptr), ledger(nullptr),
+    owner(nullptr),
     dnum(0), mask(0), maxpartner(INITIAL_CAPACITY), nmax_alloc(0)
 {
   if (narg != 4)
@@ -52,6 +56,82 @@ FixJKRDTContacts::~FixJKRDTContacts()
   memory->destroy(partner);
   memory->destroy(values);
   memory->destroy(ledger);
+  memory->destroy(owner);
+}
+
+/* ----------------------------------------------------------------------
+   between runs: atom IDs renumbered under the stored contacts are refused;
+   contacts whose partner was deleted are removed (called by the pair style)
+------------------------------------------------------------------------- */
+
+void FixJKRDTContacts::check_atoms(bigint natoms_before)
+{
+  int renumbered = 0;
+  for (int i = 0; i < atom->nlocal; i++)
+    if (npartner[i] > 0 && owner[i] != atom->tag[i]) renumbered++;
+  int any = 0;
+  MPI_Allreduce(&renumbered, &any, 1, MPI_INT, MPI_SUM, world);
+  if (any)
+    error->all(FLERR,
+               "pair jkr/dt: the IDs of {} atoms with contacts changed since the contacts were "
+               "stored (delete_atoms ... compress yes, reset_atoms id, ...), so each contact "
+               "would point at another grain. Delete with 'delete_atoms ... compress no', and "
+               "renumber only before the first run",
+               any);
+  if (natoms_before <= 0 || atom->natoms >= natoms_before) return;
+
+  // atoms were deleted: every rank learns the IDs that remain
+  const int n = atom->nlocal;
+  std::vector<int> counts(comm->nprocs), displs(comm->nprocs, 0);
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, world);
+  for (int r = 1; r < comm->nprocs; r++) displs[r] = displs[r - 1] + counts[r - 1];
+  std::vector<tagint> ids(displs.back() + counts.back());
+  MPI_Allgatherv(atom->tag, n, MPI_LMP_TAGINT, ids.data(), counts.data(), displs.data(),
+                 MPI_LMP_TAGINT, world);
+  std::sort(ids.begin(), ids.end());
+
+  // ... and every stored (atom, partner) pair: each contact is stored with both atoms, so
+  // a pair whose partner exists but does not store it back was renumbered, not deleted
+  std::vector<tagint> mine_edges;
+  for (int i = 0; i < atom->nlocal; i++)
+    for (int k = 0; k < npartner[i]; k++) {
+      mine_edges.push_back(atom->tag[i]);
+      mine_edges.push_back(partner[i][k]);
+    }
+  const int ne = static_cast<int>(mine_edges.size());
+  MPI_Allgather(&ne, 1, MPI_INT, counts.data(), 1, MPI_INT, world);
+  for (int r = 1; r < comm->nprocs; r++) displs[r] = displs[r - 1] + counts[r - 1];
+  std::vector<tagint> flat(displs.back() + counts.back());
+  MPI_Allgatherv(mine_edges.data(), ne, MPI_LMP_TAGINT, flat.data(), counts.data(),
+                 displs.data(), MPI_LMP_TAGINT, world);
+  std::vector<std::pair<tagint, tagint>> edges;
+  for (size_t e = 0; e < flat.size(); e += 2) edges.emplace_back(flat[e], flat[e + 1]);
+  std::sort(edges.begin(), edges.end());
+
+  bigint mine = 0, removed = 0;
+  int lonely = 0, anylonely = 0;
+  for (int i = 0; i < atom->nlocal; i++)
+    for (int k = npartner[i] - 1; k >= 0; k--) {
+      const tagint t = partner[i][k];
+      if (!std::binary_search(ids.begin(), ids.end(), t)) {
+        remove(i, k);
+        mine++;
+      } else if (!std::binary_search(edges.begin(), edges.end(),
+                                     std::make_pair(t, atom->tag[i]))) {
+        lonely++;
+      }
+    }
+  MPI_Allreduce(&lonely, &anylonely, 1, MPI_INT, MPI_SUM, world);
+  if (anylonely)
+    error->all(FLERR,
+               "pair jkr/dt: after delete_atoms, {} stored contacts point at atoms that do not "
+               "store them back: the atom IDs were renumbered (delete_atoms ... compress yes), "
+               "so each contact would point at another grain. Delete with 'delete_atoms ... "
+               "compress no'",
+               anylonely);
+  MPI_Allreduce(&mine, &removed, 1, MPI_LMP_BIGINT, MPI_SUM, world);
+  if (removed && comm->me == 0)
+    utils::logmesg(lmp, "pair jkr/dt: {} contacts with deleted atoms removed\n", removed);
 }
 
 /* ----------------------------------------------------------------------
@@ -142,6 +222,7 @@ int FixJKRDTContacts::find(int i, tagint partner_tag) const
 double *FixJKRDTContacts::add(int i, tagint partner_tag)
 {
   if (npartner[i] == maxpartner) grow_partner_capacity(maxpartner + 1);
+  owner[i] = atom->tag[i];
   const int k = npartner[i]++;
   partner[i][k] = partner_tag;
   if (dnum == 0) return nullptr;
@@ -195,6 +276,7 @@ void FixJKRDTContacts::grow_arrays(int nmax)
   memory->grow(partner, nmax, maxpartner, "jkr/dt:partner");
   if (dnum) memory->grow(values, nmax, maxpartner * dnum, "jkr/dt:values");
   memory->grow(ledger, nmax, NLEDGER, "jkr/dt:ledger");
+  memory->grow(owner, nmax, "jkr/dt:owner");
   nmax_alloc = nmax;
   for (int i = oldmax; i < nmax; i++) set_arrays(i);
   array_atom = ledger;
@@ -206,16 +288,18 @@ void FixJKRDTContacts::copy_arrays(int i, int j, int /*delflag*/)
   std::copy_n(partner[i], npartner[i], partner[j]);
   if (dnum) std::copy_n(values[i], npartner[i] * dnum, values[j]);
   std::copy_n(ledger[i], (int) NLEDGER, ledger[j]);
+  owner[j] = owner[i];
 }
 
 void FixJKRDTContacts::set_arrays(int i)
 {
   npartner[i] = 0;
+  owner[i] = 0;
   std::fill(ledger[i], ledger[i] + NLEDGER, 0.0);
 }
 
 /* ----------------------------------------------------------------------
-   migration between ranks: count, partner IDs, values, ledger
+   migration between ranks: count, partner IDs, values, ledger, owner ID
 ------------------------------------------------------------------------- */
 
 int FixJKRDTContacts::pack_exchange(int i, double *buf)
@@ -225,6 +309,7 @@ int FixJKRDTContacts::pack_exchange(int i, double *buf)
   for (int k = 0; k < npartner[i]; k++) buf[m++] = ubuf(partner[i][k]).d;
   for (int k = 0; k < npartner[i] * dnum; k++) buf[m++] = values[i][k];
   for (int l = 0; l < NLEDGER; l++) buf[m++] = ledger[i][l];
+  buf[m++] = ubuf(owner[i]).d;
   return m;
 }
 
@@ -237,11 +322,12 @@ int FixJKRDTContacts::unpack_exchange(int nlocal, double *buf)
   for (int k = 0; k < n; k++) partner[nlocal][k] = (tagint) ubuf(buf[m++]).i;
   for (int k = 0; k < n * dnum; k++) values[nlocal][k] = buf[m++];
   for (int l = 0; l < NLEDGER; l++) ledger[nlocal][l] = buf[m++];
+  owner[nlocal] = (tagint) ubuf(buf[m++]).i;
   return m;
 }
 
 /* ----------------------------------------------------------------------
-   restart: size, layout mask, count, partner IDs, values, ledger.
+   restart: size, layout mask, count, partner IDs, values, ledger, owner ID.
    The mask lets a run read a file written with other fields switched on.
 ------------------------------------------------------------------------- */
 
@@ -277,11 +363,12 @@ void FixJKRDTContacts::unpack_restart(int nlocal, int nth)
         std::copy_n(buf + fileoffset[f], FIELD_SIZE[f], dst + field_offset[f]);
   }
   for (int l = 0; l < NLEDGER; l++) ledger[nlocal][l] = *buf++;
+  owner[nlocal] = (tagint) ubuf(*buf++).i;
 }
 
 int FixJKRDTContacts::size_restart(int i)
 {
-  return 3 + npartner[i] * (1 + dnum) + NLEDGER;
+  return 4 + npartner[i] * (1 + dnum) + NLEDGER;
 }
 
 // called on every rank by write_restart, so it may reduce over ranks
@@ -290,7 +377,7 @@ int FixJKRDTContacts::maxsize_restart()
   int nmine = 0, nall = 0;
   for (int i = 0; i < atom->nlocal; i++) nmine = std::max(nmine, npartner[i]);
   MPI_Allreduce(&nmine, &nall, 1, MPI_INT, MPI_MAX, world);
-  return 3 + nall * (1 + dnum) + NLEDGER;
+  return 4 + nall * (1 + dnum) + NLEDGER;    // as size_restart()
 }
 
 /* ---------------------------------------------------------------------- */

@@ -46,6 +46,7 @@ class FixJKRDTContacts : public Fix {
   ~FixJKRDTContacts() override;
   int setmask() override { return 0; }
   void init() override;
+  void check_atoms(bigint natoms_before);
   void post_run() override;
   double compute_scalar() override { return dnum; }    // doubles stored per contact
 
@@ -75,6 +76,7 @@ class FixJKRDTContacts : public Fix {
   tagint **partner;     // atom IDs of the partners
   double **values;      // per-contact values, dnum per contact
   double **ledger;      // dissipated energy by channel, NLEDGER per atom
+  tagint *owner;        // the atom's ID when its contacts were stored (renumbering check)
   int dnum;             // doubles per contact under the current layout
 
  private:

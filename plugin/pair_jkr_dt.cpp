@@ -56,7 +56,7 @@ PairJKRDT::PairJKRDT(LAMMPS *lmp) :
     Pair(lmp), fix_contacts(nullptr), visited(nullptr), nmax_visited(0), nstride(0),
     dt_check(DT_CHECK_ERROR), tc_min(0.0), tc_types{0, 0}, tc_logged(0.0), dt_logged(0.0),
     dt_warned(0.0), checked_laststep(-1), step_max(0.0),
-    step_warned(false), contacts_at_run_end(0), data_contacts(0)
+    step_warned(false), contacts_at_run_end(0), natoms_at_run_end(0), data_contacts(0)
 {
   single_enable = 0;
   restartinfo = 1;
@@ -112,7 +112,10 @@ void PairJKRDT::init_style()
   // a channel that pair_coeff switched off since the last run hands its springs' energy
   // to its ledger while the old constants are still known
   auto *held = dynamic_cast<Contacts *>(modify->get_fix_by_id(FIX_ID));
-  if (held && held == fix_contacts) book_channels_switched_off(fresh, *held);
+  if (held && held == fix_contacts) {
+    held->check_atoms(natoms_at_run_end);    // deleted partners gone, renumbering refused
+    book_channels_switched_off(fresh, *held);
+  }
   param = fresh;
   check_periodic_images(cutmax);
   check_neighbor_settings();

@@ -106,6 +106,7 @@ class PairJKRDT : public Pair {
   bool step_warned;            // the warning of report_run() is given once
   bigint contacts_at_run_end;  // bonded contacts when the last run ended (write_data marks it)
   bigint data_contacts;        // contacts a data file read by read_data left behind
+  bigint natoms_at_run_end;    // atoms when the last run ended (deleted partners are dropped)
   FixJKRDTContacts *fix_contacts;
   int *visited;                // bonded contacts of each local atom seen this step
   int nmax_visited;

@@ -302,6 +302,7 @@ void PairJKRDT::report_run()
   for (int i = 0; i < atom->nlocal; i++) mine += fix_contacts->npartner[i];
   MPI_Allreduce(&mine, &contacts_at_run_end, 1, MPI_LMP_BIGINT, MPI_SUM, world);
   contacts_at_run_end /= 2;    // each contact is stored with both of its atoms
+  natoms_at_run_end = atom->natoms;
   if (step_warned || most <= STEP_WARN) return;
   step_warned = true;
   if (comm->me == 0)

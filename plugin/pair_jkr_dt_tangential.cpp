@@ -166,6 +166,11 @@ void PairJKRDT::book_channels_switched_off(const std::vector<Param> &fresh, Cont
   const tagint *tag = atom->tag;
   const int *type = atom->type;
   int unseen = 0;
+  bool any_off = false;
+  for (size_t k = 0; k < fresh.size(); k++)
+    any_off = any_off || (param[k].sliding && !fresh[k].sliding) ||
+        (param[k].rolling && !fresh[k].rolling) || (param[k].twisting && !fresh[k].twisting);
+  if (!any_off) return;
   for (int i = 0; i < atom->nlocal; i++)
     for (int k = 0; k < C.npartner[i]; k++) {
       const int j = (atom->map_style != Atom::MAP_NONE) ? atom->map(C.partner[i][k]) : -1;

@@ -157,3 +157,35 @@ def test_switching_a_channel_off_books_its_springs_energy(lmp, switch):
         dropped = before[slot] - after[slot]                    # U_s, U_r, U_t that left pe
         assert after[ledger_slot] - before[ledger_slot] == pytest.approx(dropped, rel=1e-12,
                                                                          abs=1e-30)
+
+
+def lone_grain_and_stuck_pair(lmp):
+    """Atoms 1 and 2 bonded at equilibrium, atom 3 alone far off; one run done."""
+    two_grain_scene(lmp, 2 * R_GRAIN - S.delta0)              # atoms 1, 2
+    lmp.command("create_atoms 1 single -1e-6 1e-6 1e-6")          # atom 3, alone
+    lmp.command("set atom 3 diameter 2e-7 density 1000")
+    lmp.command("run 10 post no")
+    assert bonded(lmp) == 1
+
+
+def test_delete_atoms_with_compress_is_refused(lmp):
+    lone_grain_and_stuck_pair(lmp)
+    lmp.command("group lone id 1")
+    lmp.command("delete_atoms group lone compress yes")     # the lone 3 becomes 1
+    with pytest.raises(Exception, match=r"1 stored contacts point at atoms that do not store "
+                                        r"them back.*'delete_atoms \.\.\. compress no'"):
+        lmp.command("run 10")
+
+
+def test_deleting_a_bonded_atom_removes_its_contacts(tmp_path):
+    log = tmp_path / "log.lammps"
+    lmp = start_lammps(log=log)
+    try:
+        lone_grain_and_stuck_pair(lmp)
+        lmp.command("group gone id 2")
+        lmp.command("delete_atoms group gone compress no")
+        lmp.command("run 10 post no")
+        assert bonded(lmp) == 0 and lmp.get_natoms() == 2
+    finally:
+        lmp.close()
+    assert "pair jkr/dt: 1 contacts with deleted atoms removed" in log.read_text()
