@@ -93,17 +93,17 @@ def summarise(campaign, plot: bool = True, include_cap: bool = False) -> dict:
             for o in every]
     write_csv(campaign / "runs.csv", rows)
     allowed = set(COMPLETE) | ({"cap"} if include_cap else set())
-    outcomes = [o for o in every if o.get("stop_reason", "steps") in allowed]
-    left_out = [dict(run=o["run"], stop_reason=o.get("stop_reason"), problem=o.get("problem"))
-                for o in every if o.get("stop_reason", "steps") not in allowed]
-    capped = defaultdict(int)
+    outcomes, left_out = [], []
+    capped, dropped = defaultdict(int), defaultdict(int)
     for o in every:
-        if o.get("stop_reason") == "cap":
-            capped[(label(o), o["v_col"])] += 1
-    dropped = defaultdict(int)
-    for o in every:
-        if o.get("stop_reason", "steps") not in allowed:
-            dropped[(label(o), o["v_col"])] += 1
+        reason, key = o.get("stop_reason", "steps"), (label(o), o["v_col"])
+        capped[key] += reason == "cap"
+        if reason in allowed:
+            outcomes.append(o)
+        else:
+            dropped[key] += 1
+            left_out.append(dict(run=o["run"], stop_reason=o.get("stop_reason"),
+                                 problem=o.get("problem")))
     if not outcomes:
         raise ValueError(f"{campaign}: none of its {len(every)} runs is complete "
                          f"({sorted({d['stop_reason'] for d in left_out})}); see runs.csv")

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from jkrdt.materials import from_dict, scales
-from jkrdt.stopping import ENERGY_WARN
+from jkrdt.stopping import ENERGY_WARN, STOP_WORDS
 
 from . import fragments as frag
 from .dumps import frames
@@ -23,7 +23,7 @@ from .outcome import energy_scalings, measure_frame
 from .plots import energy_partition, snapshot
 from .status import run_status
 from .tables import write_csv, write_json
-from .thermo import CHANNELS, energy_budget, read_thermo
+from .thermo import CHANNELS, energy_budget, energy_error, read_thermo
 
 
 class RunNotComplete(ValueError):
@@ -90,7 +90,7 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
         upto = thermo["Step"] <= frame.step
         at = np.flatnonzero(thermo["Step"] == frame.step)
         left = budget["kinetic"][at[0]] if at.size else budget["kinetic"][upto][-1]
-        error = float(np.abs(budget["total"] - budget["total"][0]).max() / e_imp)
+        error = energy_error(budget, e_imp)
         t_end = float(thermo["Time"][at[0]] if at.size else thermo["Time"][upto][-1])
         out.update(time_end=t_end, time_end_over_tc=t_end / s.t_c)
         out.update(kinetic_left=float(left / e_imp), energy_error=error,
@@ -129,9 +129,7 @@ def summary_text(out: dict) -> str:
         + (f" = {out['E_imp_over_nk_Eroll']:.3g} n_k E_roll" if out['E_imp_over_nk_Eroll'] else "")
         + f" = {out['E_imp_over_nk_Ebreak']:.3g} n_k E_break",
     ]
-    ended = {"settled": "settled", "cap": "hit the cap before settling",
-             "steps": "ran its fixed number of steps (no settle rule)",
-             "error": "FAILED", "cut off": "was CUT OFF"}[out["stop_reason"]]
+    ended = STOP_WORDS[out["stop_reason"]]
     lines.append(f"run ended                   {ended} at step {out['stop_step']}"
                  + (f" (analysed up to step {out['last_step']})"
                     if out["last_step"] != out["stop_step"] else "")

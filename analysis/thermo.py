@@ -38,6 +38,12 @@ def read_thermo(log) -> dict[str, np.ndarray]:
     return {name: data[:, k] for k, name in enumerate(names)}
 
 
+def energy_error(budget: dict[str, np.ndarray], e_imp: float) -> float:
+    """max |dE| / E_imp over a run, dE the change of the conserved total."""
+    total = budget["total"]
+    return float(np.abs(total - total[0]).max() / e_imp)
+
+
 def energy_budget(thermo: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     """Kinetic (with rotation), potential, dissipated (in all and by channel:
     'events' = contact formation and breaking, 'damping', 'sliding', 'rolling',

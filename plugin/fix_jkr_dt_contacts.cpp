@@ -81,13 +81,8 @@ void FixJKRDTContacts::check_atoms(bigint natoms_before)
   if (natoms_before <= 0 || atom->natoms >= natoms_before) return;
 
   // atoms were deleted: every rank learns the IDs that remain
-  const int n = atom->nlocal;
-  std::vector<int> counts(comm->nprocs), displs(comm->nprocs, 0);
-  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, world);
-  for (int r = 1; r < comm->nprocs; r++) displs[r] = displs[r - 1] + counts[r - 1];
-  std::vector<tagint> ids(displs.back() + counts.back());
-  MPI_Allgatherv(atom->tag, n, MPI_LMP_TAGINT, ids.data(), counts.data(), displs.data(),
-                 MPI_LMP_TAGINT, world);
+  std::vector<tagint> ids = gather(std::vector<tagint>(atom->tag, atom->tag + atom->nlocal),
+                                   world);
   std::sort(ids.begin(), ids.end());
 
   // ... and every stored (atom, partner) pair: each contact is stored with both atoms, so
@@ -98,12 +93,7 @@ void FixJKRDTContacts::check_atoms(bigint natoms_before)
       mine_edges.push_back(atom->tag[i]);
       mine_edges.push_back(partner[i][k]);
     }
-  const int ne = static_cast<int>(mine_edges.size());
-  MPI_Allgather(&ne, 1, MPI_INT, counts.data(), 1, MPI_INT, world);
-  for (int r = 1; r < comm->nprocs; r++) displs[r] = displs[r - 1] + counts[r - 1];
-  std::vector<tagint> flat(displs.back() + counts.back());
-  MPI_Allgatherv(mine_edges.data(), ne, MPI_LMP_TAGINT, flat.data(), counts.data(),
-                 displs.data(), MPI_LMP_TAGINT, world);
+  const std::vector<tagint> flat = gather(mine_edges, world);
   std::vector<std::pair<tagint, tagint>> edges;
   for (size_t e = 0; e < flat.size(); e += 2) edges.emplace_back(flat[e], flat[e + 1]);
   std::sort(edges.begin(), edges.end());
@@ -141,15 +131,35 @@ void FixJKRDTContacts::check_atoms(bigint natoms_before)
 void FixJKRDTContacts::init()
 {
   if (force->pair_match("jkr/dt", 1, 0)) return;
-  bigint mine = 0, stored = 0;
-  for (int i = 0; i < atom->nlocal; i++) mine += npartner[i];
-  MPI_Allreduce(&mine, &stored, 1, MPI_LMP_BIGINT, MPI_SUM, world);
+  const bigint stored = count();
   if (stored > 0)
     error->all(FLERR,
                "pair jkr/dt: the pair style is now {}, but {} bonded contacts of jkr/dt are "
                "stored; a run without jkr/dt would leave them stale. Keep pair_style jkr/dt "
                "(use pair_style hybrid/overlay to add another), or 'unfix {}' to drop them",
-               force->pair_style ? force->pair_style : "none", stored / 2, id);
+               force->pair_style ? force->pair_style : "none", stored, id);
+}
+
+bigint FixJKRDTContacts::count() const
+{
+  bigint mine = 0, all = 0;
+  for (int i = 0; i < atom->nlocal; i++) mine += npartner[i];
+  MPI_Allreduce(&mine, &all, 1, MPI_LMP_BIGINT, MPI_SUM, world);
+  return all / 2;    // each contact is stored with both of its atoms
+}
+
+std::vector<tagint> FixJKRDTContacts::gather(const std::vector<tagint> &mine, MPI_Comm world)
+{
+  int nprocs = 1;
+  MPI_Comm_size(world, &nprocs);
+  const int n = static_cast<int>(mine.size());
+  std::vector<int> counts(nprocs), displs(nprocs, 0);
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, world);
+  for (int r = 1; r < nprocs; r++) displs[r] = displs[r - 1] + counts[r - 1];
+  std::vector<tagint> all(displs.back() + counts.back());
+  MPI_Allgatherv(mine.data(), n, MPI_LMP_TAGINT, all.data(), counts.data(), displs.data(),
+                 MPI_LMP_TAGINT, world);
+  return all;
 }
 
 /* ----------------------------------------------------------------------

@@ -28,6 +28,8 @@
 
 #include "fix.h"
 
+#include <vector>
+
 namespace LAMMPS_NS {
 
 class FixJKRDTContacts : public Fix {
@@ -47,6 +49,9 @@ class FixJKRDTContacts : public Fix {
   int setmask() override { return 0; }
   void init() override;
   void check_atoms(bigint natoms_before);
+  bigint count() const;    // bonded contacts over all ranks (collective)
+  // the concatenation of every rank's ``mine``, in rank order, on every rank (collective)
+  static std::vector<tagint> gather(const std::vector<tagint> &mine, MPI_Comm world);
   void post_run() override;
   double compute_scalar() override { return dnum; }    // doubles stored per contact
 

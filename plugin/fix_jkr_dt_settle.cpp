@@ -15,7 +15,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -104,13 +103,7 @@ FixJKRDTSettle::Partition FixJKRDTSettle::partition() const
   if (C)
     for (int i = 0; i < atom->nlocal; i++)
       for (int l = 0; l < FixJKRDTContacts::NLEDGER; l++) dissipated += C->ledger[i][l];
-  const int n = static_cast<int>(mine.size());
-  std::vector<int> counts(comm->nprocs), displs(comm->nprocs, 0);
-  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, world);
-  std::partial_sum(counts.begin(), counts.end() - 1, displs.begin() + 1);
-  std::vector<tagint> edges(displs.back() + counts.back());
-  MPI_Allgatherv(mine.data(), n, MPI_LMP_TAGINT, edges.data(), counts.data(), displs.data(),
-                 MPI_LMP_TAGINT, world);
+  const std::vector<tagint> edges = FixJKRDTContacts::gather(mine, world);
 
   // union by size over the atoms that have contacts; the others are single grains
   std::unordered_map<tagint, int> index;

@@ -272,8 +272,7 @@ PairJKRDT::Param PairJKRDT::resolve(int i, int j) const
 
 double PairJKRDT::init_one(int i, int j)
 {
-  // parameters were resolved in init_style(); keep them symmetric
-  param[j * nstride + i] = param[i * nstride + j];
+  // parameters were resolved, for (i,j) and (j,i) alike, in init_style()
   return par(i, j).cut;
 }
 

@@ -298,10 +298,7 @@ void PairJKRDT::report_run()
   double most = 0.0;
   MPI_Allreduce(&step_max, &most, 1, MPI_DOUBLE, MPI_MAX, world);
   step_max = 0.0;
-  bigint mine = 0;
-  for (int i = 0; i < atom->nlocal; i++) mine += fix_contacts->npartner[i];
-  MPI_Allreduce(&mine, &contacts_at_run_end, 1, MPI_LMP_BIGINT, MPI_SUM, world);
-  contacts_at_run_end /= 2;    // each contact is stored with both of its atoms
+  contacts_at_run_end = fix_contacts->count();
   natoms_at_run_end = atom->natoms;
   if (step_warned || most <= STEP_WARN) return;
   step_warned = true;

@@ -28,7 +28,7 @@ from .campaign import BUILDERS
 from .datafile import write_sphere_data
 from .materials import PRESETS, material, scales
 from .session import find_deck, scene_variables, write_scene_deck
-from .stopping import DEFAULT_RULE, ENERGY_WARN, SettleRule
+from .stopping import DEFAULT_RULE, ENERGY_WARN, STOP_WORDS, SettleRule
 
 
 def run_lammps(deck: Path, out: Path, variables: dict, nproc: int = 1) -> None:
@@ -97,11 +97,13 @@ def build(args) -> int:
     return 0
 
 
+#: the outputs a new run of a scene replaces; LAMMPS appends to none of them, but a run
+#: that fails early would leave the last run's behind
+RUN_OUTPUTS = ("atoms.dump", "contacts.dump", "log.lammps")
 #: what a scene directory holds once set up, run and analysed: all that --force clears
-SCENE_FILES = ("collision.data", "collision.json", "in.collision.lmp", "atoms.dump",
-               "contacts.dump", "log.lammps", "frames.csv", "outcome.json", "outcome.png",
-               "outcome.pdf", "energy.png", "energy.pdf", "restart.a", "restart.b",
-               "final.restart", "final.dump")
+SCENE_FILES = ("collision.data", "collision.json", "in.collision.lmp", *RUN_OUTPUTS,
+               "frames.csv", "outcome.json", "outcome.png", "outcome.pdf", "energy.png",
+               "energy.pdf", "restart.a", "restart.b", "final.restart", "final.dump")
 
 
 def write_scene(kind, n_tar, n_pro, radius, mat, v, b_off, seed, dim, model, out,
@@ -148,7 +150,7 @@ def run_scene(out: Path, model, dt: float | None, steps: int | None, nproc: int,
     """Run a scene written by ``write_scene`` with the deck, in its own directory: until
     it settles by ``rule`` (the cap included), or ``steps`` steps when given."""
     from jkrdt.analysis.status import run_status
-    from jkrdt.analysis.thermo import energy_budget, read_thermo
+    from jkrdt.analysis.thermo import energy_budget, energy_error, read_thermo
 
     variables = scene_variables(out, model, dt)
     variables["out"] = out
@@ -157,17 +159,14 @@ def run_scene(out: Path, model, dt: float | None, steps: int | None, nproc: int,
         variables.update(rule.deck_variables(dt))
     else:
         variables.update(settle="no", steps=steps, every=output_interval(steps))
-    for stale in ("atoms.dump", "contacts.dump", "log.lammps"):
+    for stale in RUN_OUTPUTS:
         (out / stale).unlink(missing_ok=True)
     t0 = time.time()
     run_lammps(find_deck(), out, variables, nproc=nproc)
     status = run_status(out)
     budget = energy_budget(read_thermo(out / "log.lammps"))
-    e_imp = json.loads((out / "collision.json").read_text())["E_imp"]
-    error = float(np.abs(budget["total"] - budget["total"][0]).max() / e_imp)
-    ended = {"settled": "settled", "cap": "hit the cap without settling",
-             "steps": "ran its steps"}.get(status.stop_reason, status.stop_reason)
-    print(f"{ended} at step {status.stop_step} of at most {variables['steps']} "
+    error = energy_error(budget, json.loads((out / "collision.json").read_text())["E_imp"])
+    print(f"{STOP_WORDS[status.stop_reason]} at step {status.stop_step} of at most {variables['steps']} "
           f"({variables['model']}, dt = {dt:g} t_c) in {time.time() - t0:.1f} s on {nproc} "
           f"rank(s); max |dE| / E_imp = {error:.2e}; log, dumps and restarts in {out}")
     if error > ENERGY_WARN:

@@ -251,8 +251,9 @@ class Session:
 
     def energy_error(self) -> float:
         """max |dE| / E_imp over the samples so far (dE: change of the conserved total)."""
-        total = self.energies()["total"]
-        return float(np.abs(total - total[0]).max() / self.meta["E_imp"])
+        from jkrdt.analysis.thermo import energy_error
+
+        return energy_error(self.energies(), self.meta["E_imp"])
 
     def warn_energy(self) -> None:
         error = self.energy_error()

@@ -30,6 +30,10 @@ ENERGY_WARN = 1.0e-3
 #: stop reasons written in outcome.json: settled and fixed-length ("steps") runs are
 #: complete; a run that hit its cap or an error did not end its collision
 COMPLETE = ("settled", "steps")
+#: how the summaries and jkrdt run say each stop reason
+STOP_WORDS = {"settled": "settled", "cap": "hit the cap before settling",
+              "steps": "ran its fixed number of steps (no settle rule)",
+              "error": "FAILED", "cut off": "was CUT OFF"}
 
 
 @dataclasses.dataclass(frozen=True)
