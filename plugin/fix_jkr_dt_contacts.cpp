@@ -11,6 +11,7 @@
 #include "memory.h"
 
 #include <algorithm>
+#include <limits>
 #include <utility>
 #include <vector>
 #include <cstring>
@@ -23,8 +24,7 @@ static constexpr int INITIAL_CAPACITY = 8;
 
 FixJKRDTContacts::FixJKRDTContacts(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), npartner(nullptr), partner(nullptr), values(nullptr), ledger(nullptr),
-    owner(nullptr),
-    dnum(0), mask(0), maxpartner(INITIAL_CAPACITY), nmax_alloc(0)
+    owner(nullptr), dnum(0), natoms_at_run_end(0), mask(0), maxpartner(INITIAL_CAPACITY), nmax_alloc(0)
 {
   if (narg != 4)
     error->all(FLERR,
@@ -60,68 +60,73 @@ FixJKRDTContacts::~FixJKRDTContacts()
 }
 
 /* ----------------------------------------------------------------------
-   between runs: atom IDs renumbered under the stored contacts are refused;
-   contacts whose partner was deleted are removed (called by the pair style)
+   between runs, the contacts follow their atoms (called by the pair style):
+   a contact whose partner was deleted is removed, and partner IDs that a
+   command renumbered (delete_atoms ... compress yes, reset_atoms id) are
+   carried to the new IDs. Each atom with contacts knows its own ID at the
+   time they were stored (owner), so the old-to-new map is the set of
+   (owner, tag) of all such atoms. A contact whose two atoms swap their ID
+   order swaps its pointers n1 <-> n2 (the twisting angle of eq. (24) and
+   the damping force do not change with the labels).
 ------------------------------------------------------------------------- */
 
 void FixJKRDTContacts::check_atoms(bigint natoms_before)
 {
-  int renumbered = 0;
-  for (int i = 0; i < atom->nlocal; i++)
-    if (npartner[i] > 0 && owner[i] != atom->tag[i]) renumbered++;
-  int any = 0;
-  MPI_Allreduce(&renumbered, &any, 1, MPI_INT, MPI_SUM, world);
-  if (any)
-    error->all(FLERR,
-               "pair jkr/dt: the IDs of {} atoms with contacts changed since the contacts were "
-               "stored (delete_atoms ... compress yes, reset_atoms id, ...), so each contact "
-               "would point at another grain. Delete with 'delete_atoms ... compress no', and "
-               "renumber only before the first run",
-               any);
-  if (natoms_before <= 0 || atom->natoms >= natoms_before) return;
+  const int nlocal = atom->nlocal;
+  const tagint *tag = atom->tag;
+  int moved = 0;
+  for (int i = 0; i < nlocal; i++)
+    if (npartner[i] > 0 && owner[i] != tag[i]) moved++;
+  int changed[2] = {moved, natoms_before > 0 && atom->natoms < natoms_before};
+  int any[2] = {0, 0};
+  MPI_Allreduce(changed, any, 2, MPI_INT, MPI_MAX, world);
+  if (!any[0] && !any[1]) return;
 
-  // atoms were deleted: every rank learns the IDs that remain
-  std::vector<tagint> ids = gather(std::vector<tagint>(atom->tag, atom->tag + atom->nlocal),
-                                   world);
-  std::sort(ids.begin(), ids.end());
-
-  // ... and every stored (atom, partner) pair: each contact is stored with both atoms, so
-  // a pair whose partner exists but does not store it back was renumbered, not deleted
-  std::vector<tagint> mine_edges;
-  for (int i = 0; i < atom->nlocal; i++)
-    for (int k = 0; k < npartner[i]; k++) {
-      mine_edges.push_back(atom->tag[i]);
-      mine_edges.push_back(partner[i][k]);
+  std::vector<tagint> mine;
+  for (int i = 0; i < nlocal; i++)
+    if (npartner[i] > 0) {
+      mine.push_back(owner[i]);
+      mine.push_back(tag[i]);
     }
-  const std::vector<tagint> flat = gather(mine_edges, world);
-  std::vector<std::pair<tagint, tagint>> edges;
-  for (size_t e = 0; e < flat.size(); e += 2) edges.emplace_back(flat[e], flat[e + 1]);
-  std::sort(edges.begin(), edges.end());
+  const std::vector<tagint> flat = gather(mine, world);
+  std::vector<std::pair<tagint, tagint>> renamed;    // (ID when stored, ID now)
+  for (size_t e = 0; e < flat.size(); e += 2) renamed.emplace_back(flat[e], flat[e + 1]);
+  std::sort(renamed.begin(), renamed.end());
 
-  bigint mine = 0, removed = 0;
-  int lonely = 0, anylonely = 0;
-  for (int i = 0; i < atom->nlocal; i++)
+  const int off_n = has_field(POINTERS) ? offset(POINTERS) : -1;
+  bigint counts[2] = {0, 0}, all[2] = {0, 0};    // contacts removed, atoms renamed
+  for (int i = 0; i < nlocal; i++) {
+    if (npartner[i] > 0 && owner[i] != tag[i]) counts[1]++;
     for (int k = npartner[i] - 1; k >= 0; k--) {
-      const tagint t = partner[i][k];
-      if (!std::binary_search(ids.begin(), ids.end(), t)) {
+      const tagint was = partner[i][k];
+      auto it = std::lower_bound(renamed.begin(), renamed.end(),
+                                 std::make_pair(was, std::numeric_limits<tagint>::min()));
+      if (it == renamed.end() || it->first != was) {    // the partner is gone
         remove(i, k);
-        mine++;
-      } else if (!std::binary_search(edges.begin(), edges.end(),
-                                     std::make_pair(t, atom->tag[i]))) {
-        lonely++;
+        counts[0]++;
+        continue;
       }
+      const tagint now = it->second;
+      if (off_n >= 0 && (owner[i] < was) != (tag[i] < now)) {
+        double *n = contact_values(i, k) + off_n;
+        std::swap_ranges(n, n + 3, n + 3);
+      }
+      partner[i][k] = now;
     }
-  MPI_Allreduce(&lonely, &anylonely, 1, MPI_INT, MPI_SUM, world);
-  if (anylonely)
+    owner[i] = tag[i];
+  }
+  MPI_Allreduce(counts, all, 2, MPI_LMP_BIGINT, MPI_SUM, world);
+  if (all[0] && !any[1])
     error->all(FLERR,
-               "pair jkr/dt: after delete_atoms, {} stored contacts point at atoms that do not "
-               "store them back: the atom IDs were renumbered (delete_atoms ... compress yes), "
-               "so each contact would point at another grain. Delete with 'delete_atoms ... "
-               "compress no'",
-               anylonely);
-  MPI_Allreduce(&mine, &removed, 1, MPI_LMP_BIGINT, MPI_SUM, world);
-  if (removed && comm->me == 0)
-    utils::logmesg(lmp, "pair jkr/dt: {} contacts with deleted atoms removed\n", removed);
+               "pair jkr/dt: {} stored contacts point at atoms that no longer store them, "
+               "though no atom was deleted: the contact state is inconsistent",
+               all[0]);
+  if (comm->me == 0) {
+    if (all[0]) utils::logmesg(lmp, "pair jkr/dt: {} contacts with deleted atoms removed\n", all[0]);
+    if (all[1])
+      utils::logmesg(lmp, "pair jkr/dt: the contacts of {} renumbered atoms follow their new IDs\n",
+                     all[1]);
+  }
 }
 
 /* ----------------------------------------------------------------------
@@ -355,7 +360,8 @@ void FixJKRDTContacts::unpack_restart(int nlocal, int nth)
   double **extra = atom->extra;
   int m = 0;
   for (int k = 0; k < nth; k++) m += static_cast<int>(extra[nlocal][m]);
-  const double *buf = extra[nlocal] + m + 1;
+  const double *record = extra[nlocal] + m;
+  const double *buf = record + 1;
 
   const int filemask = static_cast<int>(*buf++);
   int fileoffset[NFIELD];
@@ -373,7 +379,9 @@ void FixJKRDTContacts::unpack_restart(int nlocal, int nth)
         std::copy_n(buf + fileoffset[f], FIELD_SIZE[f], dst + field_offset[f]);
   }
   for (int l = 0; l < NLEDGER; l++) ledger[nlocal][l] = *buf++;
-  owner[nlocal] = (tagint) ubuf(*buf++).i;
+  // files written before the owner ID was stored end here: their IDs are the atoms' own
+  const bool has_owner = buf - record < static_cast<int>(record[0]);
+  owner[nlocal] = has_owner ? (tagint) ubuf(*buf).i : atom->tag[nlocal];
 }
 
 int FixJKRDTContacts::size_restart(int i)

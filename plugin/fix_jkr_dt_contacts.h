@@ -28,6 +28,8 @@
 
 #include "fix.h"
 
+#include "pair_jkr_dt.h"
+
 #include <vector>
 
 namespace LAMMPS_NS {
@@ -83,6 +85,13 @@ class FixJKRDTContacts : public Fix {
   double **ledger;      // dissipated energy by channel, NLEDGER per atom
   tagint *owner;        // the atom's ID when its contacts were stored (renumbering check)
   int dnum;             // doubles per contact under the current layout
+
+  // what the stored state was made with, as of the last run's end (set by the pair style):
+  // the resolved constants of every type pair, so that a pair style that takes the contacts
+  // over can book the springs of a channel switched off, and the atom count, so that it can
+  // tell deleted partners from renumbered ones
+  std::vector<PairJKRDT::Param> made_with;
+  bigint natoms_at_run_end;
 
  private:
   int mask;             // bit f set = field f stored

@@ -56,7 +56,7 @@ PairJKRDT::PairJKRDT(LAMMPS *lmp) :
     Pair(lmp), fix_contacts(nullptr), visited(nullptr), nmax_visited(0), nstride(0),
     dt_check(DT_CHECK_ERROR), tc_min(0.0), tc_types{0, 0}, tc_logged(0.0), dt_logged(0.0),
     dt_warned(0.0), checked_laststep(-1), step_max(0.0),
-    step_warned(false), contacts_at_run_end(0), natoms_at_run_end(0), data_contacts(0)
+    step_warned(false), contacts_at_run_end(0), data_contacts(0)
 {
   single_enable = 0;
   restartinfo = 1;
@@ -109,11 +109,14 @@ void PairJKRDT::init_style()
       fresh[i * nstride + j] = fresh[j * nstride + i] = resolve(i, j);
       cutmax = std::max(cutmax, fresh[i * nstride + j].cut);
     }
-  // a channel that pair_coeff switched off since the last run hands its springs' energy
-  // to its ledger while the old constants are still known
+  // stored contacts, whether this pair style made them or takes them over from one that
+  // a pair_style command replaced: deleted partners go, renumbering is refused, and a
+  // channel switched off since the last run hands its springs' energy to its ledger
+  // with the constants the springs were made with
   auto *held = dynamic_cast<Contacts *>(modify->get_fix_by_id(FIX_ID));
-  if (held && held == fix_contacts) {
-    held->check_atoms(natoms_at_run_end);    // deleted partners gone, renumbering refused
+  if (held) {
+    fix_contacts = held;
+    held->check_atoms(held->natoms_at_run_end);
     book_channels_switched_off(fresh, *held);
   }
   param = fresh;
@@ -299,6 +302,9 @@ void PairJKRDT::compute(int eflag, int vflag)
 
       const bool formed = !bonded;    // delta >= 0 here: contact formation (section 2.1)
       if (formed && setup) check_initial_overlap(p, q, delta, S);
+      // a contact forms within the step that closes the gap: deeper means it was missed
+      if (formed && !setup && delta > 2.0 * step + LATE_SLACK * S.delta_c)
+        report_late_contact(p, q, delta, step, S);
       if (formed) {
         if (p_own) state_p = C.add(p, tag[q]);
         if (q_own) state_q = C.add(q, tag[p]);

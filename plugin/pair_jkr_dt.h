@@ -67,6 +67,8 @@ class PairJKRDT : public Pair {
   static constexpr double DT_WARN = 0.1;      // above: energy errors of 1e-3 and more
   static constexpr double DT_STABLE = 0.4;    // above: the integration cannot hold
   static constexpr double STEP_WARN = 0.5;    // warn: a contact moved this * delta_c in one step
+  static constexpr double LATE_SLACK = 1e-3;  // a new contact may be this * delta_c deeper than
+                                              // a step's normal travel (curvature of the path)
   enum DtCheck { DT_CHECK_OFF = 0, DT_CHECK_WARN, DT_CHECK_ERROR };
 
   PairJKRDT(class LAMMPS *);
@@ -106,7 +108,6 @@ class PairJKRDT : public Pair {
   bool step_warned;            // the warning of report_run() is given once
   bigint contacts_at_run_end;  // bonded contacts when the last run ended (write_data marks it)
   bigint data_contacts;        // contacts a data file read by read_data left behind
-  bigint natoms_at_run_end;    // atoms when the last run ended (deleted partners are dropped)
   FixJKRDTContacts *fix_contacts;
   int *visited;                // bonded contacts of each local atom seen this step
   int nmax_visited;
@@ -138,6 +139,8 @@ class PairJKRDT : public Pair {
   void check_initial_overlap(int p, int q, double delta, const JKRDT::NormalScales &S) const;
   [[noreturn]] void report_blow_up(int p, int q, double r) const;
   [[noreturn]] void report_fast_pair(int p, int q, double vn) const;
+  [[noreturn]] void report_late_contact(int p, int q, double delta, double step,
+                                        const JKRDT::NormalScales &S) const;
   [[noreturn]] void report_not_finite(int p, int q, const char *what) const;
   void book(int channel, double energy, int p, int q, int nlocal);
   static double breaking_loss(double delta, double vn, double dt, const JKRDT::NormalScales &S);

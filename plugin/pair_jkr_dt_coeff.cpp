@@ -52,6 +52,7 @@ void PairJKRDT::settings(int narg, char **arg)
 {
   // pair_style jkr/dt [dt_check error|warn|off]
   dt_check = DT_CHECK_ERROR;
+  data_contacts = 0;    // the deliberate fresh start from a marked data file
   if (fix_contacts && !modify->get_fix_by_id(FIX_ID)) {    // given anew after an unfix
     fix_contacts = nullptr;
     contacts_at_run_end = 0;
@@ -195,7 +196,9 @@ void PairJKRDT::coeff(int narg, char **arg)
       count++;
     }
   if (count == 0) error->all(FLERR, "pair_coeff for jkr/dt: no type pair matched {} {}", arg[0], arg[1]);
-  data_contacts = marked;    // a pair_coeff given anew clears a data file's mark
+  // a data file's mark stays through later pair_coeff commands (decks give their own after
+  // read_data); only pair_style jkr/dt given anew clears it
+  data_contacts = std::max(data_contacts, marked);
 }
 
 /* ----------------------------------------------------------------------

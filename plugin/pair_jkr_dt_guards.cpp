@@ -72,6 +72,11 @@ void PairJKRDT::find_max_radii()
 
 void PairJKRDT::check_neighbor_settings() const
 {
+  if (neighbor->build_once)
+    error->all(FLERR,
+               "pair jkr/dt: neighbor lists are built once per run (neigh_modify once yes); "
+               "contacts form and break between any two steps, so a stale list misses them. "
+               "Use 'neigh_modify once no every 1 delay 0 check yes'");
   if (neighbor->every != 1 || neighbor->delay != 0)
     error->all(FLERR,
                "pair jkr/dt: neighbor lists checked every {} steps after a delay of {}; contacts "
@@ -231,6 +236,26 @@ void PairJKRDT::report_fast_pair(int p, int q, double vn) const
 }
 
 /* ----------------------------------------------------------------------
+   a contact first seen deeper than the pair moved in the step: the list
+   missed its formation, or something other than the integration moved
+   the atoms during the run
+------------------------------------------------------------------------- */
+
+void PairJKRDT::report_late_contact(int p, int q, double delta, double step,
+                                    const JKRDT::NormalScales &S) const
+{
+  error->one(FLERR,
+             "pair jkr/dt: the contact between atoms {} and {} is first seen at step {} "
+             "already overlapped by {:.4g} ({:.3g} delta_c), more than the {:.4g} they moved "
+             "towards each other in the step: it was missed when it formed. Either the "
+             "neighbor list did not hold the pair (neigh_modify exclude, a list not rebuilt) "
+             "or the atoms were moved by something other than the integration (a fix that "
+             "moves atoms, or positions changed between 'run N pre no' chunks). Move atoms "
+             "only before a run that does its set-up ('run N', pre yes)",
+             atom->tag[p], atom->tag[q], update->ntimestep, delta, delta / S.delta_c, step);
+}
+
+/* ----------------------------------------------------------------------
    a stored contact that the neighbor loop did not see: say why and stop
 ------------------------------------------------------------------------- */
 
@@ -272,7 +297,8 @@ void PairJKRDT::report_unvisited_contact()
                    "before it could break: they are {:.4g} apart ({:.4g} beyond r1 + r2), but "
                    "their relative speed moves them only {:.4g} per step: they were moved by "
                    "something other than the integration (set, displace_atoms, change_box, a "
-                   "fix that moves atoms). Move bonded grains together, or delete the contacts' "
+                   "fix that moves atoms), or neigh_modify exclude took the pair out of the "
+                   "list. Move bonded grains together, or delete the contacts' "
                    "atoms first",
                    tag[i], t, r, gap, move);
       error->one(FLERR,
@@ -299,7 +325,8 @@ void PairJKRDT::report_run()
   MPI_Allreduce(&step_max, &most, 1, MPI_DOUBLE, MPI_MAX, world);
   step_max = 0.0;
   contacts_at_run_end = fix_contacts->count();
-  natoms_at_run_end = atom->natoms;
+  fix_contacts->natoms_at_run_end = atom->natoms;
+  fix_contacts->made_with = param;
   if (step_warned || most <= STEP_WARN) return;
   step_warned = true;
   if (comm->me == 0)
@@ -326,8 +353,8 @@ void PairJKRDT::check_data_file_contacts() const
                "pair jkr/dt: this data file was written by write_data from a state with {} "
                "bonded contacts, which a data file cannot carry (pointers, twist, damping force, "
                "energy ledger): the run would start with them all broken. Continue from "
-               "write_restart / read_restart instead, or give pair_coeff again to start from the "
-               "positions alone",
+               "write_restart / read_restart instead; to start from the positions alone, give "
+               "'pair_style jkr/dt' again after read_data, then pair_coeff",
                data_contacts);
 }
 

@@ -155,7 +155,9 @@ void PairJKRDT::tangential_step(int p, int q, const Param &P, const NormalScales
 
 /* ----------------------------------------------------------------------
    a channel switched off between runs (pair_coeff ... frictionless): the
-   energy its springs hold, eqs. (11), (21), (25) with the old constants,
+   energy its springs hold, eqs. (11), (21), (25) with the constants of the
+   last run (kept by the contact fix, so that this holds across a pair_style
+   command too),
    leaves pe and goes to the channel's ledger, half to each atom of the
    contact, so that ke + erotate + pe + dissipated stays what it was
 ------------------------------------------------------------------------- */
@@ -165,11 +167,13 @@ void PairJKRDT::book_channels_switched_off(const std::vector<Param> &fresh, Cont
   double **x = atom->x;
   const tagint *tag = atom->tag;
   const int *type = atom->type;
+  const std::vector<Param> &last = C.made_with;
+  if (last.size() != fresh.size()) return;    // no run yet
   int unseen = 0;
   bool any_off = false;
   for (size_t k = 0; k < fresh.size(); k++)
-    any_off = any_off || (param[k].sliding && !fresh[k].sliding) ||
-        (param[k].rolling && !fresh[k].rolling) || (param[k].twisting && !fresh[k].twisting);
+    any_off = any_off || (last[k].sliding && !fresh[k].sliding) ||
+        (last[k].rolling && !fresh[k].rolling) || (last[k].twisting && !fresh[k].twisting);
   if (!any_off) return;
   for (int i = 0; i < atom->nlocal; i++)
     for (int k = 0; k < C.npartner[i]; k++) {
@@ -178,7 +182,7 @@ void PairJKRDT::book_channels_switched_off(const std::vector<Param> &fresh, Cont
         unseen++;
         continue;
       }
-      const Param &before = par(type[i], type[j]);
+      const Param &before = last[type[i] * nstride + type[j]];
       const Param &after = fresh[type[i] * nstride + type[j]];
       const bool off[NCHANNEL] = {before.sliding && !after.sliding,
                                   before.rolling && !after.rolling,

@@ -1,6 +1,7 @@
 """The contact state across LAMMPS commands between runs: what is carried through, and
 what is refused with the way that works named."""
 
+import json
 import shutil
 import subprocess
 import sys
@@ -53,15 +54,54 @@ def test_write_data_warns_and_a_run_from_it_is_refused(tmp_path):
         lmp.close()
 
 
-def test_pair_coeff_given_again_starts_from_the_positions(tmp_path):
+def test_a_decks_own_pair_coeff_after_read_data_is_still_refused(tmp_path):
+    # decks give their own coefficients after read_data: the file's mark must outlive them
     _, data = write_data_after_a_run(tmp_path)
     lmp = start_lammps()
     try:
         lmp.commands_string(READ_BACK.format(data=data))
         lmp.command("pair_coeff * * gamma 0.1 E 7e9 nu 0.25 frictionless")
+        with pytest.raises(Exception, match="1 bonded contacts.*write_restart / read_restart.*"
+                                            "'pair_style jkr/dt' again after read_data"):
+            lmp.command("run 10")
+    finally:
+        lmp.close()
+
+
+def test_pair_style_given_again_starts_from_the_positions(tmp_path):
+    _, data = write_data_after_a_run(tmp_path)
+    lmp = start_lammps()
+    try:
+        lmp.commands_string(READ_BACK.format(data=data))
+        lmp.command("pair_style jkr/dt")                # the fresh start the error names
+        lmp.command("pair_coeff * * gamma 0.1 E 7e9 nu 0.25 frictionless")
         lmp.command("compute p all pair jkr/dt")
         lmp.command("run 10")
         assert lmp.numpy.extract_compute("p", 0, 1)[9] == 1    # the contact formed anew
+    finally:
+        lmp.close()
+
+
+def test_restart_files_written_before_owner_ids_continue_bit_for_bit():
+    # tests/data: a spinning, sliding stuck pair written by the plugin before the contact
+    # fix stored each atom's own ID, and where that plugin's own continuation ended
+    data = Path(__file__).parent / "data"
+    expected = json.loads((data / "before_owner_ids.json").read_text())["after_300_more_steps"]
+    lmp = start_lammps()
+    try:
+        lmp.commands_string(f"""
+            read_restart {data / "before_owner_ids.restart"}
+            comm_modify vel yes
+            pair_style jkr/dt
+            pair_coeff * * gamma {ICE.gamma!r} E {ICE.E!r} nu {ICE.nu!r} xi_crit 8e-10
+            neighbor {2 * S.delta_c!r} bin
+            fix integrate all nve/sphere
+            run 150
+            run 150
+        """)                      # the second run checks each atom's stored ID
+        order = np.argsort(lmp.numpy.extract_atom("id")[:2])
+        assert np.array_equal(lmp.numpy.extract_atom("x")[:2][order], expected["x"])
+        assert np.array_equal(lmp.numpy.extract_atom("omega")[:2][order], expected["omega"])
     finally:
         lmp.close()
 
@@ -168,13 +208,54 @@ def lone_grain_and_stuck_pair(lmp):
     assert bonded(lmp) == 1
 
 
-def test_delete_atoms_with_compress_is_refused(lmp):
+def sliding_spinning_pair_and_a_lone_grain(lmp, renumber=None):
+    """Atoms 1 and 2 stuck, 2 at lower x than 1, sliding and spinning (pointers and twist
+    loaded); atom 3 alone far off at the lowest x. 300 steps, ``renumber``, 300 steps;
+    returns ids, positions and spins ordered by x, and the ledger."""
+    two_grain_scene(lmp, -(2 * R_GRAIN - S.delta0), coeff_extra="xi_crit 8e-10")
+    lmp.command("create_atoms 1 single -1e-6 0 0")
+    lmp.command("set atom 3 diameter 2e-7 density 1000")
+    lmp.command("set atom 1 omega 2e6 1e6 3e6")
+    lmp.command("set atom 2 vy 0.05")
+    lmp.command("run 300 post no")
+    if renumber:
+        lmp.commands_string(renumber)
+    lmp.command("run 300 post no")
+    n = lmp.get_natoms()
+    x = lmp.numpy.extract_atom("x")[:n]
+    order = np.argsort(x[:, 0])
+    return (lmp.numpy.extract_atom("id")[:n][order].tolist(), x[order].copy(),
+            lmp.numpy.extract_atom("omega")[:n][order].copy(), ledger(lmp))
+
+
+@pytest.mark.parametrize("renumber, ids_after", [
+    # spatial sort: the lone grain becomes 1, the pair 2 and 3 in flipped order (n1 <-> n2)
+    ("reset_atoms id sort yes", [1, 2, 3]),
+    # ... and then the lone grain is deleted with compress yes: 2, 3 become 2, 1
+    ("reset_atoms id sort yes\ngroup lone id 1\ndelete_atoms group lone compress yes", [2, 1]),
+])
+def test_renumbered_atoms_keep_their_contacts(renumber, ids_after):
+    straight = start_lammps()
+    renumbered = start_lammps()
+    try:
+        ids0, x0, w0, e0 = sliding_spinning_pair_and_a_lone_grain(straight)
+        ids1, x1, w1, e1 = sliding_spinning_pair_and_a_lone_grain(renumbered, renumber)
+    finally:
+        straight.close()
+        renumbered.close()
+    assert ids0 == [3, 2, 1] and ids1 == ids_after       # ordered by x
+    # the pair continues exactly as without the renumbering: same grains, same state
+    assert np.array_equal(x1[-2:], x0[-2:]) and np.array_equal(w1[-2:], w0[-2:])
+    assert e1["p10"] == e0["p10"] == 1
+
+
+def test_delete_atoms_compress_yes_carries_the_survivors_contacts(lmp):
+    # delete atom 2 of the pair: its partner loses the contact; no wrong atom is blamed
     lone_grain_and_stuck_pair(lmp)
-    lmp.command("group lone id 1")
-    lmp.command("delete_atoms group lone compress yes")     # the lone 3 becomes 1
-    with pytest.raises(Exception, match=r"1 stored contacts point at atoms that do not store "
-                                        r"them back.*'delete_atoms \.\.\. compress no'"):
-        lmp.command("run 10")
+    lmp.command("group gone id 2")
+    lmp.command("delete_atoms group gone compress yes")     # 3 becomes 2
+    lmp.command("run 10 post no")
+    assert bonded(lmp) == 0 and lmp.get_natoms() == 2
 
 
 def test_deleting_a_bonded_atom_removes_its_contacts(tmp_path):
@@ -189,3 +270,56 @@ def test_deleting_a_bonded_atom_removes_its_contacts(tmp_path):
     finally:
         lmp.close()
     assert "pair jkr/dt: 1 contacts with deleted atoms removed" in log.read_text()
+
+
+def test_a_channel_switched_off_across_a_pair_style_swap_is_booked(lmp):
+    # the constants the springs were made with live in the contact fix, so a pair style
+    # that takes the contacts over books them with the last run's values
+    two_grain_scene(lmp, 2 * R_GRAIN - S.delta0, coeff_extra="xi_crit 8e-10")
+    lmp.command("set atom 1 omega 2e6 1e6 3e6")
+    lmp.command("run 300 post no")
+    before = ledger(lmp)
+    lmp.command("pair_style zero 1e-7")
+    lmp.command("pair_coeff * *")
+    lmp.command("pair_style jkr/dt")
+    lmp.command("pair_coeff * * gamma 0.1 E 7e9 nu 0.25 frictionless")
+    lmp.command("run 0 post no")
+    after = ledger(lmp)
+    held = before["p2"] + before["p3"] + before["p4"]
+    assert held > 0 and after["p2"] == after["p3"] == after["p4"] == 0
+    assert after["total"] == pytest.approx(before["total"], rel=1e-12)
+    booked = sum(after[k] - before[k] for k in ("p7", "p8", "p9"))
+    assert booked == pytest.approx(held, rel=1e-12)
+
+
+def test_replicate_works_before_the_first_run_and_is_refused_after(lmp):
+    two_grain_scene(lmp, 2 * R_GRAIN - S.delta0, box=2e-6)
+    lmp.command("change_box all boundary p f f")
+    lmp.command("replicate 2 1 1")                    # no contacts stored yet
+    lmp.command("run 10 post no")
+    assert bonded(lmp) == 2 and lmp.get_natoms() == 4
+    with pytest.raises(Exception, match="Cannot replicate with fixes that store per-atom"):
+        lmp.command("replicate 2 1 1")
+
+
+def test_change_box_that_stretches_a_contact_is_named(lmp):
+    stuck_pair(lmp)
+    lmp.command("change_box all boundary f f f")          # changes nothing for the pair
+    lmp.command("run 10 post no")
+    assert bonded(lmp) == 1
+    lmp.command("change_box all x final -3e-6 3e-6 remap")   # pulls the pair 1.5x apart
+    with pytest.raises(Exception, match="moved by something other than the integration.*"
+                                        "change_box"):
+        lmp.command("run 10")
+
+
+def test_a_contact_found_deeper_than_a_step_travel_is_named(lmp):
+    # the issue's late neighbor check, by the one route the refusals leave open: positions
+    # changed from Python between chunks that skip their set-up
+    two_grain_scene(lmp, 2 * R_GRAIN + 0.5 * S.delta_c, skin=4 * S.delta_c)   # apart, at rest
+    lmp.command("run 10 post no")
+    lmp.numpy.extract_atom("x")[1, 0] = 2 * R_GRAIN - 0.5 * S.delta0
+    with pytest.raises(Exception, match=r"atoms 1 and 2 is first seen at step 11 already "
+                                        r"overlapped by .*it was missed when it formed.*"
+                                        r"'run N pre no' chunks"):
+        lmp.command("run 10 pre no")

@@ -185,6 +185,7 @@ def test_deep_but_physical_overlap_flies_apart_with_the_energy_kept(lmp):
 @pytest.mark.parametrize("neighbor_line, pattern", [
     ("neighbor 0.0 bin", "neighbor skin is 0; a stretched contact then leaves the list"),
     ("neigh_modify every 10 check no", "checked every 10 steps.*'neigh_modify every 1 delay 0"),
+    ("neigh_modify once yes", "built once per run.*'neigh_modify once no every 1 delay 0"),
 ])
 def test_neighbor_settings_that_lose_contacts_are_refused(lmp, neighbor_line, pattern):
     grains(lmp, 2 * R_GRAIN)
