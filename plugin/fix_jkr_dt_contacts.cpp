@@ -9,6 +9,8 @@
 #include "error.h"
 #include "force.h"
 #include "memory.h"
+#include "neigh_list.h"
+#include "neighbor.h"
 
 #include <algorithm>
 #include <limits>
@@ -24,7 +26,9 @@ static constexpr int INITIAL_CAPACITY = 8;
 
 FixJKRDTContacts::FixJKRDTContacts(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), npartner(nullptr), partner(nullptr), values(nullptr), ledger(nullptr),
-    owner(nullptr), dnum(0), natoms_at_run_end(0), mask(0), maxpartner(INITIAL_CAPACITY), nmax_alloc(0)
+    owner(nullptr), dnum(0), bonded(nullptr), slot_values(nullptr), slot_first(nullptr),
+    natoms_at_run_end(0), mask(0), maxpartner(INITIAL_CAPACITY), nmax_alloc(0), nslot(0),
+    maxslot(0), slot_dnum(0), maxfirst(0), slot_list(nullptr), slot_build(-1), rows_stale(false)
 {
   if (narg != 4)
     error->all(FLERR,
@@ -57,6 +61,9 @@ FixJKRDTContacts::~FixJKRDTContacts()
   memory->destroy(values);
   memory->destroy(ledger);
   memory->destroy(owner);
+  memory->destroy(bonded);
+  memory->destroy(slot_values);
+  memory->destroy(slot_first);
 }
 
 /* ----------------------------------------------------------------------
@@ -168,11 +175,13 @@ std::vector<tagint> FixJKRDTContacts::gather(const std::vector<tagint> &mine, MP
 }
 
 /* ----------------------------------------------------------------------
-   end of a run: the pair style reports how well the step resolved contacts
+   end of a run: the rows take the state, and the pair style reports how
+   well the step resolved contacts
 ------------------------------------------------------------------------- */
 
 void FixJKRDTContacts::post_run()
 {
+  to_rows();    // between runs the rows are the state
   auto *pair = dynamic_cast<PairJKRDT *>(force->pair_match("jkr/dt", 1, 0));
   if (pair) pair->report_run();
 }
@@ -220,6 +229,128 @@ void FixJKRDTContacts::set_layout(int newmask)
   mask = newmask;
   dnum = newdnum;
   std::copy_n(newoffset, NFIELD, field_offset);
+}
+
+int FixJKRDTContacts::setmask()
+{
+  return FixConst::PRE_EXCHANGE | FixConst::POST_NEIGHBOR;
+}
+
+/* ----------------------------------------------------------------------
+   after every neighbor list build: the slots of the pair's new list
+------------------------------------------------------------------------- */
+
+void FixJKRDTContacts::post_neighbor()
+{
+  auto *pair = dynamic_cast<PairJKRDT *>(force->pair_match("jkr/dt", 1, 0));
+  if (pair && pair->list) to_slots(pair->list);
+}
+
+bool FixJKRDTContacts::slots_follow(const NeighList *list) const
+{
+  return list == slot_list && slot_build == neighbor->lastcall;
+}
+
+/* ----------------------------------------------------------------------
+   rows -> slots, by partner ID. Atom i of the half list is always owned;
+   a pair of two owned atoms must be stored by both, and every stored
+   contact must be found in the list, or it is named and the run stops
+------------------------------------------------------------------------- */
+
+void FixJKRDTContacts::to_slots(NeighList *list)
+{
+  if (rows_stale)
+    error->one(FLERR, "pair jkr/dt: the contact state was not written back before the "
+                      "neighbor list was rebuilt (internal error)");
+  const int inum = list->inum;
+  const int *ilist = list->ilist, *numneigh = list->numneigh;
+  int **firstneigh = list->firstneigh;
+  const int nlocal = atom->nlocal;
+  const tagint *tag = atom->tag;
+
+  if (inum + 1 > maxfirst) {
+    maxfirst = inum + 1 + inum / 4;
+    memory->destroy(slot_first);
+    memory->create(slot_first, maxfirst, "jkr/dt:slot_first");
+  }
+  int n = 0;
+  for (int ii = 0; ii < inum; ii++) {
+    slot_first[ii] = n;
+    n += numneigh[ilist[ii]];
+  }
+  slot_first[inum] = n;
+  if (n > maxslot || dnum != slot_dnum) {
+    maxslot = std::max(maxslot, n + n / 4 + 16);
+    slot_dnum = dnum;
+    memory->destroy(bonded);
+    memory->destroy(slot_values);
+    memory->create(bonded, maxslot, "jkr/dt:bonded");
+    if (dnum) memory->create(slot_values, (bigint) maxslot * dnum, "jkr/dt:slot_values");
+  }
+  nslot = n;
+
+  std::vector<int> found(nlocal, 0);
+  bool one_sided = false;
+  tagint one_sided_ids[2] = {0, 0};
+  for (int ii = 0; ii < inum; ii++) {
+    const int i = ilist[ii];
+    const int *jlist = firstneigh[i];
+    int s = slot_first[ii];
+    for (int jj = 0; jj < numneigh[i]; jj++, s++) {
+      const int j = jlist[jj] & NEIGHMASK;
+      const int k = find(i, tag[j]);
+      if (j < nlocal && (k >= 0) != (find(j, tag[i]) >= 0)) {
+        one_sided = true;
+        one_sided_ids[0] = tag[i];
+        one_sided_ids[1] = tag[j];
+      }
+      bonded[s] = k >= 0;
+      if (k < 0) continue;
+      found[i]++;
+      if (j < nlocal) found[j]++;
+      if (dnum) std::copy_n(contact_values(i, k), dnum, slot_values + (bigint) s * dnum);
+    }
+  }
+  if (one_sided)
+    error->one(FLERR, "pair jkr/dt: contact {}-{} is stored with only one of its atoms",
+               one_sided_ids[0], one_sided_ids[1]);
+  for (int i = 0; i < nlocal; i++)
+    if (found[i] != npartner[i]) {
+      auto *pair = dynamic_cast<PairJKRDT *>(force->pair_match("jkr/dt", 1, 0));
+      pair->report_lost_contact();    // names the contact and why; does not return
+    }
+  slot_list = list;
+  slot_build = neighbor->lastcall;
+}
+
+/* ----------------------------------------------------------------------
+   slots -> rows: each owned atom's row becomes the bonded slots it is in
+------------------------------------------------------------------------- */
+
+void FixJKRDTContacts::to_rows()
+{
+  if (!rows_stale) return;
+  rows_stale = false;
+  const NeighList *list = slot_list;
+  const int nlocal = atom->nlocal;
+  const tagint *tag = atom->tag;
+  for (int i = 0; i < nlocal; i++) npartner[i] = 0;
+  for (int ii = 0; ii < list->inum; ii++) {
+    const int i = list->ilist[ii];
+    const int *jlist = list->firstneigh[i];
+    int s = slot_first[ii];
+    for (int jj = 0; jj < list->numneigh[i]; jj++, s++) {
+      if (!bonded[s]) continue;
+      const int j = jlist[jj] & NEIGHMASK;
+      const double *v = dnum ? slot_values + (bigint) s * dnum : nullptr;
+      double *row = add(i, tag[j]);
+      if (v) std::copy_n(v, dnum, row);
+      if (j < nlocal) {
+        row = add(j, tag[i]);
+        if (v) std::copy_n(v, dnum, row);
+      }
+    }
+  }
 }
 
 /* ----------------------------------------------------------------------
@@ -405,5 +536,6 @@ double FixJKRDTContacts::memory_usage()
   const double nmax = nmax_alloc;
   return nmax *
       (sizeof(int) + maxpartner * (sizeof(tagint) + dnum * sizeof(double)) +
-       NLEDGER * sizeof(double));
+       NLEDGER * sizeof(double) + sizeof(tagint)) +
+      (double) maxslot * (1 + slot_dnum * sizeof(double)) + (double) maxfirst * sizeof(int);
 }

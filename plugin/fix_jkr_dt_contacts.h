@@ -1,9 +1,23 @@
-/* jkr/dt: per-contact state, keyed by the pair of atom IDs.
+/* jkr/dt: per-contact state, in two forms.
 
-   Every bonded contact is stored twice, once with each of its two atoms,
-   as (partner ID, per-contact values). The storage is per atom, so it moves
-   with its atom between MPI ranks (pack/unpack_exchange), follows atom
-   sorting (copy_arrays) and goes into restart files (pack/unpack_restart).
+   Between reneighborings the state lives in list order: one slot per pair
+   of the pair style's neighbor list, in the order the pair loop visits
+   them, holding a bonded flag and the contact's values. The pair loop reads
+   and writes it sequentially, one copy per pair.
+
+   Where atoms can move between MPI ranks, be sorted, deleted or written to
+   a restart file, the state lives per atom: every bonded contact stored
+   twice, once with each of its two atoms, as (partner ID, per-contact
+   values). This form moves with its atom between ranks (pack/unpack_exchange),
+   follows atom sorting and deletion (copy_arrays) and goes into restart
+   files (pack/unpack_restart).
+
+   The per-atom rows are written from the slots (to_rows) before atoms
+   migrate (pre_exchange of a reneighbor step), at the end of a run, and
+   whenever a reader asks (PairJKRDT::contacts(), restart files); the slots
+   are filled from the rows by partner ID after every neighbor list build
+   (post_neighbor), which is also where a contact missing from the new list
+   is caught and named.
    The pair style creates this fix and is the only writer. The fix outlives
    a pair_style command that replaces jkr/dt, and then refuses to run while
    it holds contacts (they would go stale); pair_style jkr/dt takes them back.
@@ -48,8 +62,12 @@ class FixJKRDTContacts : public Fix {
 
   FixJKRDTContacts(class LAMMPS *, int, char **);
   ~FixJKRDTContacts() override;
-  int setmask() override { return 0; }
+  int setmask() override;
   void init() override;
+  void setup_pre_exchange() override { to_rows(); }
+  void pre_exchange() override { to_rows(); }
+  void setup_post_neighbor() override { post_neighbor(); }
+  void post_neighbor() override;
   void check_atoms(bigint natoms_before);
   bigint count() const;    // bonded contacts over all ranks (collective)
   // the concatenation of every rank's ``mine``, in rank order, on every rank (collective)
@@ -61,6 +79,16 @@ class FixJKRDTContacts : public Fix {
   int layout_mask() const { return mask; }
   bool has_field(Field f) const { return (mask >> f) & 1; }
   int offset(Field f) const { return field_offset[f]; }
+
+  // list-order state: slot s of the pair loop (running over ilist, then each
+  // atom's neighbors) is bonded if bonded[s], with values slot_values + s * dnum
+  void to_slots(class NeighList *list);
+  void to_rows();
+  bool slots_follow(const class NeighList *list) const;
+  void rows_changed() { rows_stale = true; }
+  unsigned char *bonded;     // per slot: 1 = a bonded contact
+  double *slot_values;       // per slot: dnum values
+  int *slot_first;           // per ilist entry: its first slot
 
   int find(int i, tagint partner_tag) const;
   double *add(int i, tagint partner_tag);
@@ -100,6 +128,11 @@ class FixJKRDTContacts : public Fix {
   int nmax_alloc;       // rows allocated in the per-atom arrays
 
   void grow_partner_capacity(int needed);
+  int nslot, maxslot, slot_dnum;    // slots in use, allocated, values per allocated slot
+  int maxfirst;                     // ilist entries allocated
+  const class NeighList *slot_list; // the list the slots follow ...
+  bigint slot_build;                // ... as built at this step (neighbor->lastcall)
+  bool rows_stale;                  // the slots hold state the rows do not
   static int layout_size(int mask, int *offsets);
 };
 

@@ -4,8 +4,10 @@
    Parallel layout. The style asks for a half neighbor list built as with
    newton off, whatever the global newton setting: a pair with one ghost atom
    is computed on both ranks, and each rank writes forces and contact state
-   only for its own atoms. Every contact is stored with both of its atoms, so
-   no reverse communication of contact state is ever needed. Each pair is
+   only for its own atoms. The contact state is kept in list order, one copy
+   per pair of this rank's list (FixJKRDTContacts): a pair with a ghost atom
+   is kept, and advanced identically, on both ranks, so no reverse
+   communication of contact state is ever needed. Each pair is
    evaluated in its canonical orientation (particle 1 = smaller atom ID), so
    the two ranks do the same arithmetic on the same numbers.
 
@@ -53,7 +55,7 @@ const char *const PairJKRDT::FIX_ID = "JKR_DT_CONTACTS";
 /* ---------------------------------------------------------------------- */
 
 PairJKRDT::PairJKRDT(LAMMPS *lmp) :
-    Pair(lmp), fix_contacts(nullptr), visited(nullptr), nmax_visited(0), nstride(0),
+    Pair(lmp), fix_contacts(nullptr), nstride(0),
     dt_check(DT_CHECK_ERROR), tc_min(0.0), tc_types{0, 0}, tc_logged(0.0), dt_logged(0.0),
     dt_warned(0.0), checked_laststep(-1), step_max(0.0),
     step_warned(false), contacts_at_run_end(0), data_contacts(0)
@@ -72,7 +74,6 @@ PairJKRDT::PairJKRDT(LAMMPS *lmp) :
 PairJKRDT::~PairJKRDT()
 {
   delete[] pvector;
-  memory->destroy(visited);
   if (allocated) {
     memory->destroy(setflag);
     memory->destroy(cutsq);
@@ -214,42 +215,34 @@ void PairJKRDT::compute(int eflag, int vflag)
   }
 
   Contacts &C = *fix_contacts;
+  if (!C.slots_follow(list)) C.to_slots(list);    // a list built without post_neighbor
+  const int dnum = C.dnum;
   const int off_fd = C.has_field(Contacts::DAMPING_FORCE) ? C.offset(Contacts::DAMPING_FORCE) : -1;
-
-  if (nlocal > nmax_visited) {
-    memory->destroy(visited);
-    nmax_visited = atom->nmax;
-    memory->create(visited, nmax_visited, "jkr/dt:visited");
-  }
-  std::fill(visited, visited + nlocal, 0);
 
   JKRDT::NormalScales S{};
   const Param *last_param = nullptr;
   double last_r1 = -1.0, last_r2 = -1.0;
-  double upot = 0.0;
+  double upot = 0.0, contacts = 0.0;
   double utan[JKRDT::NCHANNEL] = {0.0, 0.0, 0.0};
   JKRDT::ChannelLoad load[JKRDT::NCHANNEL];
   const int inum = list->inum;
   const int *ilist = list->ilist;
   const int *numneigh = list->numneigh;
   int **firstneigh = list->firstneigh;
+  unsigned char *const bonded_slot = C.bonded;
 
   for (int ii = 0; ii < inum; ii++) {
     const int i = ilist[ii];
     const int *jlist = firstneigh[i];
-    for (int jj = 0; jj < numneigh[i]; jj++) {
+    int s = C.slot_first[ii];
+    for (int jj = 0; jj < numneigh[i]; jj++, s++) {
       const int j = jlist[jj] & NEIGHMASK;
 
       // canonical orientation: p has the smaller ID
       int p = i, q = j;
       if (tag[q] < tag[p]) std::swap(p, q);
       const bool p_own = p < nlocal, q_own = q < nlocal;
-      const int kp = p_own ? C.find(p, tag[q]) : -1;
-      const int kq = q_own ? C.find(q, tag[p]) : -1;
-      if (p_own && q_own && ((kp < 0) != (kq < 0)))
-        error->one(FLERR, "pair jkr/dt: contact {}-{} is stored with only one of its atoms",
-                   tag[p], tag[q]);
-      const bool bonded = (kp >= 0) || (kq >= 0);
+      const bool bonded = bonded_slot[s];
 
       const double delx = x[p][0] - x[q][0];
       const double dely = x[p][1] - x[q][1];
@@ -271,8 +264,7 @@ void PairJKRDT::compute(int eflag, int vflag)
         last_r2 = radius[q];
       }
 
-      double *state_p = (p_own && C.dnum) ? C.contact_values(p, kp) : nullptr;
-      double *state_q = (q_own && C.dnum) ? C.contact_values(q, kq) : nullptr;
+      double *state = dnum ? C.slot_values + (bigint) s * dnum : nullptr;
       const double rinv = 1.0 / r;
       // normal relative velocity at the half step, > 0 when separating
       const double vn = ((v[p][0] - v[q][0]) * delx + (v[p][1] - v[q][1]) * dely +
@@ -287,16 +279,12 @@ void PairJKRDT::compute(int eflag, int vflag)
         // separation (section 2.1): U_n drops to 0 from its value at the last step
         if (!setup) {
           book(Contacts::FORM_BREAK, breaking_loss(delta, vn, dt, S), p, q, nlocal);
-          if (P.damp_coef > 0.0) {
-            const double fd_prev = state_p ? state_p[off_fd] : state_q[off_fd];
-            book(Contacts::DAMPING, 0.5 * dt * fd_prev * vn, p, q, nlocal);
-          }
+          if (P.damp_coef > 0.0)
+            book(Contacts::DAMPING, 0.5 * dt * state[off_fd] * vn, p, q, nlocal);
         }
         if (P.tangential())
-          tangential_step(p, q, P, S, state_p, state_q, false, true, {delx, dely, delz}, r,
-                          load);
-        if (p_own) C.remove(p, kp);
-        if (q_own) C.remove(q, kq);
+          tangential_step(p, q, P, S, state, false, true, {delx, dely, delz}, r, load);
+        bonded_slot[s] = 0;
         continue;
       }
 
@@ -306,8 +294,8 @@ void PairJKRDT::compute(int eflag, int vflag)
       if (formed && !setup && delta > 2.0 * step + LATE_SLACK * S.delta_c)
         report_late_contact(p, q, delta, step, S);
       if (formed) {
-        if (p_own) state_p = C.add(p, tag[q]);
-        if (q_own) state_q = C.add(q, tag[p]);
+        bonded_slot[s] = 1;
+        if (state) std::fill(state, state + dnum, 0.0);
       }
 
       const double y = JKRDT::contact_sqrt_radius(delta / S.delta0);    // eq. (4)
@@ -321,12 +309,10 @@ void PairJKRDT::compute(int eflag, int vflag)
       if (P.damp_coef > 0.0) {
         // eq. (A.5); a run's first evaluation reuses the stored F_D, so that a
         // continued run equals an uninterrupted one
-        double *state = state_p ? state_p : state_q;
         const double fd_prev = formed ? 0.0 : state[off_fd];
         const double fd = (setup && !formed) ? fd_prev : P.damp_coef * y * y * S.a0 * vn;
         if (!setup) book(Contacts::DAMPING, 0.5 * dt * (fd_prev + fd) * vn, p, q, nlocal);
-        if (state_p) state_p[off_fd] = fd;
-        if (state_q) state_q[off_fd] = fd;
+        state[off_fd] = fd;
         fmag -= fd;
       }
 
@@ -335,8 +321,7 @@ void PairJKRDT::compute(int eflag, int vflag)
       JKRDT::V3 fp = {delx * fpair, dely * fpair, delz * fpair};
       double u_t = 0.0;
       if (P.tangential()) {
-        tangential_step(p, q, P, S, state_p, state_q, formed, false, {delx, dely, delz}, r,
-                        load);
+        tangential_step(p, q, P, S, state, formed, false, {delx, dely, delz}, r, load);
         JKRDT::V3 mp = {0.0, 0.0, 0.0}, mq = mp;
         for (int ch = 0; ch < JKRDT::NCHANNEL; ch++) {
           fp = fp + load[ch].F1;
@@ -361,14 +346,13 @@ void PairJKRDT::compute(int eflag, int vflag)
         f[p][0] += fp.x;
         f[p][1] += fp.y;
         f[p][2] += fp.z;
-        visited[p]++;
       }
       if (q_own) {
         f[q][0] -= fp.x;
         f[q][1] -= fp.y;
         f[q][2] -= fp.z;
-        visited[q]++;
       }
+      contacts += share;
       if (eflag) {
         upot += share * u_n;
         if (P.tangential())
@@ -378,10 +362,8 @@ void PairJKRDT::compute(int eflag, int vflag)
     }
   }
 
-  for (int i = 0; i < nlocal; i++)
-    if (visited[i] != C.npartner[i]) report_unvisited_contact();
-
-  if (eflag_global) fill_pvector(upot, utan);
+  C.rows_changed();
+  if (eflag_global) fill_pvector(upot, utan, contacts);
 }
 
 /* ----------------------------------------------------------------------
@@ -404,17 +386,14 @@ double PairJKRDT::breaking_loss(double delta, double vn, double dt, const JKRDT:
    sums them over ranks
 ------------------------------------------------------------------------- */
 
-void PairJKRDT::fill_pvector(double upot, const double *utan)
+void PairJKRDT::fill_pvector(double upot, const double *utan, double contacts)
 {
   std::fill(pvector, pvector + NPVECTOR, 0.0);
   pvector[0] = upot;    // U_n
   for (int ch = 0; ch < JKRDT::NCHANNEL; ch++) pvector[1 + ch] = utan[ch];    // U_s, U_r, U_t
   const auto &C = *fix_contacts;
-  double contacts = 0.0;
-  for (int i = 0; i < atom->nlocal; i++) {
+  for (int i = 0; i < atom->nlocal; i++)
     for (int l = 0; l < Contacts::NLEDGER; l++) pvector[4 + l] += C.ledger[i][l];
-    contacts += 0.5 * C.npartner[i];
-  }
   pvector[9] = contacts;
   for (int l = 0; l < NPVECTOR; l++)
     if (!std::isfinite(pvector[l]))
@@ -422,6 +401,12 @@ void PairJKRDT::fill_pvector(double upot, const double *utan)
                  "pair jkr/dt: value {} of the energy ledger is not finite at step {} (timestep "
                  "= {:.3g} t_c): the run has blown up; reduce the timestep",
                  l + 1, update->ntimestep, update->dt / tc_min);
+}
+
+FixJKRDTContacts *PairJKRDT::contacts()
+{
+  if (fix_contacts) fix_contacts->to_rows();
+  return fix_contacts;
 }
 
 /* ----------------------------------------------------------------------
@@ -465,6 +450,6 @@ bool PairJKRDT::bonded_contact(int i, int j, ContactView &view) const
 
 double PairJKRDT::memory_usage()
 {
-  return Pair::memory_usage() + nmax_visited * sizeof(int) +
+  return Pair::memory_usage() +
       (input.size() * sizeof(Input) + param.size() * sizeof(Param));
 }

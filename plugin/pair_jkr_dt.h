@@ -90,7 +90,9 @@ class PairJKRDT : public Pair {
   bool bonded_contact(int i, int j, ContactView &view) const;
   void report_run();         // end of a run: the largest step a contact took
   double t_c() const { return tc_min; }
-  FixJKRDTContacts *contacts() const { return fix_contacts; }
+  // the contact store with its per-atom rows current (for readers between the steps)
+  FixJKRDTContacts *contacts();
+  void report_lost_contact();    // a stored contact missing from the neighbor list
 
  protected:
   std::vector<Input> input;    // (ntypes+1)^2, row-major
@@ -109,8 +111,6 @@ class PairJKRDT : public Pair {
   bigint contacts_at_run_end;  // bonded contacts when the last run ended (write_data marks it)
   bigint data_contacts;        // contacts a data file read by read_data left behind
   FixJKRDTContacts *fix_contacts;
-  int *visited;                // bonded contacts of each local atom seen this step
-  int nmax_visited;
 
   int nstride;                 // ntypes + 1
   Input &in(int i, int j) { return input[i * nstride + j]; }
@@ -123,7 +123,7 @@ class PairJKRDT : public Pair {
   bool read_state(const double *values, JKRDT::ContactState &c) const;
   void write_state(double *values, const JKRDT::ContactState &c) const;
   void tangential_step(int p, int q, const Param &P, const JKRDT::NormalScales &S,
-                       double *state_p, double *state_q, bool formed, bool breaking,
+                       double *state, bool formed, bool breaking,
                        const JKRDT::V3 &d12, double dist, JKRDT::ChannelLoad load[JKRDT::NCHANNEL]);
   int layout_mask() const;
   void book_channels_switched_off(const std::vector<Param> &fresh, FixJKRDTContacts &C);
@@ -144,8 +144,7 @@ class PairJKRDT : public Pair {
   [[noreturn]] void report_not_finite(int p, int q, const char *what) const;
   void book(int channel, double energy, int p, int q, int nlocal);
   static double breaking_loss(double delta, double vn, double dt, const JKRDT::NormalScales &S);
-  void report_unvisited_contact();
-  void fill_pvector(double upot, const double *utan);
+  void fill_pvector(double upot, const double *utan, double contacts);
 };
 
 }    // namespace LAMMPS_NS

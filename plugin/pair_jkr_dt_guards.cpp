@@ -256,10 +256,10 @@ void PairJKRDT::report_late_contact(int p, int q, double delta, double step,
 }
 
 /* ----------------------------------------------------------------------
-   a stored contact that the neighbor loop did not see: say why and stop
+   a stored contact that the new neighbor list does not hold: say why and stop
 ------------------------------------------------------------------------- */
 
-void PairJKRDT::report_unvisited_contact()
+void PairJKRDT::report_lost_contact()
 {
   const int nlocal = atom->nlocal;
   const tagint *tag = atom->tag;

@@ -95,7 +95,7 @@ void PairJKRDT::write_state(double *values, const ContactState &c) const
 ------------------------------------------------------------------------- */
 
 void PairJKRDT::tangential_step(int p, int q, const Param &P, const NormalScales &S,
-                                double *state_p, double *state_q, bool formed, bool breaking,
+                                double *state, bool formed, bool breaking,
                                 const V3 &d12, double dist, ChannelLoad load[NCHANNEL])
 {
   double **v = atom->v;
@@ -107,7 +107,7 @@ void PairJKRDT::tangential_step(int p, int q, const Param &P, const NormalScales
   const V3 nc = (1.0 / dist) * d12;    // eq. (9)
 
   ContactState before;
-  const bool traced = !formed && read_state(state_p ? state_p : state_q, before);
+  const bool traced = !formed && read_state(state, before);
   ContactState now = before;
   if (!traced) {
     now = {-nc, nc, 0.0};    // section 2.2.4: n1(t0) = -n_c(t0), n2 = n_c
@@ -147,10 +147,7 @@ void PairJKRDT::tangential_step(int p, int q, const Param &P, const NormalScales
            q, nlocal);
     }
   }
-  if (!breaking) {
-    write_state(state_p, now);
-    write_state(state_q, now);
-  }
+  if (!breaking) write_state(state, now);
 }
 
 /* ----------------------------------------------------------------------
