@@ -79,6 +79,10 @@ class FixJKRDTContacts : public Fix {
   int layout_mask() const { return mask; }
   bool has_field(Field f) const { return (mask >> f) & 1; }
   int offset(Field f) const { return field_offset[f]; }
+  JKRDT::StateLayout layout() const
+  {
+    return {field_offset[DAMPING_FORCE], field_offset[POINTERS], field_offset[TWIST], dnum};
+  }
 
   // list-order state: slot s of the pair loop (running over ilist, then each
   // atom's neighbors) is bonded if bonded[s], with values slot_values + s * dnum

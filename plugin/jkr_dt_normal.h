@@ -29,13 +29,16 @@ namespace JKRDT {
 constexpr double PI = 3.14159265358979323846;
 
 // delta_c / delta0 = (9/16)^(1/3)
-inline double delta_c_ratio() { return std::cbrt(9.0 / 16.0); }
+inline const double DELTA_C_RATIO = std::cbrt(9.0 / 16.0);
+inline double delta_c_ratio() { return DELTA_C_RATIO; }
 
 // y = sqrt(a/a0) at the break point: a/a0 = 6^(-2/3), where d(delta)/da = 0
-inline double y_break() { return 1.0 / std::cbrt(6.0); }
+inline const double Y_BREAK = 1.0 / std::cbrt(6.0);
+inline double y_break() { return Y_BREAK; }
 
 // 4 * 6^(1/3): prefactor of U_n / (F_c delta_c), eq. (6)
-inline double potential_prefactor() { return 4.0 * std::cbrt(6.0); }
+inline const double POTENTIAL_PREFACTOR = 4.0 * std::cbrt(6.0);
+inline double potential_prefactor() { return POTENTIAL_PREFACTOR; }
 
 /* ---------------------------------------------------------------------
    scales of one contact, eqs. (1)-(2) and section 2.1
@@ -73,15 +76,19 @@ inline NormalScales normal_scales(double r1, double r2, double gamma, double a0_
    For d >= -delta_c/delta0 the stable branch is the largest root,
    y >= y_break. f(y) = 3y^4 - 2y - d is convex and increasing there, so
    Newton's method started from any y with f(y) >= 0 descends monotonically
-   onto the root. y0 = max(1, d^(1/4)) is such a start for every d:
-   d <= 1: f(1) = 1 - d >= 0;  d > 1: f(d^(1/4)) = 2d - 2 d^(1/4) > 0.
-   At d = -delta_c/delta0 the root is double and convergence is linear,
-   hence the generous iteration cap.
+   onto the root. The start is the tangent at y = 1 (f(1) = 1 - d,
+   f'(1) = 10), y0 = 1 + (d - 1)/10: f is convex, so f(y0) >= 0 for every d,
+   and y0 > y_break for every d >= -delta_c/delta0. It is within
+   (d - 1)^2 / 50 of the root for contacts near equilibrium (d ~ 1). For
+   d > 1 + 10 (d^(1/4) - 1), d^(1/4) is the closer start (f(d^(1/4)) =
+   2d - 2 d^(1/4) > 0). At d = -delta_c/delta0 the root is double and
+   convergence is linear, hence the generous iteration cap.
 ------------------------------------------------------------------------ */
 
 inline double contact_sqrt_radius(double d)
 {
-  double y = (d > 1.0) ? std::sqrt(std::sqrt(d)) : 1.0;
+  double y = 1.0 + 0.1 * (d - 1.0);
+  if (d > 2.0) y = std::fmin(y, std::sqrt(std::sqrt(d)));
   for (int iter = 0; iter < 200; ++iter) {
     const double y3 = y * y * y;
     const double f = 3.0 * y3 * y - 2.0 * y - d;
@@ -91,8 +98,7 @@ inline double contact_sqrt_radius(double d)
     y -= step;
     if (step <= 1.0e-15 * y) break;    // monotone descent: a non-positive step is the end
   }
-  const double yb = y_break();
-  return (y < yb) ? yb : y;
+  return (y < Y_BREAK) ? Y_BREAK : y;
 }
 
 /* ---------------------------------------------------------------------

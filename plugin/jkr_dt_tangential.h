@@ -94,7 +94,8 @@ struct Tangential {
 };
 
 // phi_crit = M_t,fric / k_t, eqs. (37)-(38): 1/(16 pi), about 1.1 degrees
-inline double phi_crit() { return 1.0 / (16.0 * PI); }
+constexpr double PHI_CRIT = 1.0 / (16.0 * PI);
+inline double phi_crit() { return PHI_CRIT; }
 
 /* ---------------------------------------------------------------------
    displacements, eqs. (8)-(10) and (20)

@@ -185,20 +185,25 @@ void PairJKRDT::check_periodic_images(double cutmax)
    half of a contact's dissipation goes to each of its owned atoms
 ------------------------------------------------------------------------- */
 
-void PairJKRDT::book(int channel, double energy, int p, int q, int nlocal)
+void PairJKRDT::book(const double loss[JKRDT::NLOSS], int p, int q, int nlocal)
 {
-  if (p < nlocal) fix_contacts->ledger[p][channel] += 0.5 * energy;
-  if (q < nlocal) fix_contacts->ledger[q][channel] += 0.5 * energy;
+  for (int l = 0; l < JKRDT::NLOSS; l++) {
+    if (loss[l] == 0.0) continue;
+    if (p < nlocal) fix_contacts->ledger[p][l] += 0.5 * loss[l];
+    if (q < nlocal) fix_contacts->ledger[q][l] += 0.5 * loss[l];
+  }
 }
 
 /* ---------------------------------------------------------------------- */
 
 void PairJKRDT::compute(int eflag, int vflag)
 {
+  using JKRDT::V3;
   ev_init(eflag, vflag);
 
   double **x = atom->x;
   double **v = atom->v;
+  double **omega = atom->omega;
   double **f = atom->f;
   double **torque = atom->torque;
   const double *radius = atom->radius;
@@ -216,20 +221,21 @@ void PairJKRDT::compute(int eflag, int vflag)
 
   Contacts &C = *fix_contacts;
   if (!C.slots_follow(list)) C.to_slots(list);    // a list built without post_neighbor
-  const int dnum = C.dnum;
-  const int off_fd = C.has_field(Contacts::DAMPING_FORCE) ? C.offset(Contacts::DAMPING_FORCE) : -1;
+  const JKRDT::StateLayout layout = C.layout();
+  unsigned char *const bonded_slot = C.bonded;
+  double *const slot_values = C.slot_values;
 
-  JKRDT::NormalScales S{};
+  // the constants depend on the type pair and the radii only: reuse the last ones
+  JKRDT::ContactConstants K{};
   const Param *last_param = nullptr;
   double last_r1 = -1.0, last_r2 = -1.0;
   double upot = 0.0, contacts = 0.0;
   double utan[JKRDT::NCHANNEL] = {0.0, 0.0, 0.0};
-  JKRDT::ChannelLoad load[JKRDT::NCHANNEL];
+  JKRDT::ContactResult out;
   const int inum = list->inum;
   const int *ilist = list->ilist;
   const int *numneigh = list->numneigh;
   int **firstneigh = list->firstneigh;
-  unsigned char *const bonded_slot = C.bonded;
 
   for (int ii = 0; ii < inum; ii++) {
     const int i = ilist[ii];
@@ -241,13 +247,10 @@ void PairJKRDT::compute(int eflag, int vflag)
       // canonical orientation: p has the smaller ID
       int p = i, q = j;
       if (tag[q] < tag[p]) std::swap(p, q);
-      const bool p_own = p < nlocal, q_own = q < nlocal;
       const bool bonded = bonded_slot[s];
 
-      const double delx = x[p][0] - x[q][0];
-      const double dely = x[p][1] - x[q][1];
-      const double delz = x[p][2] - x[q][2];
-      const double rsq = delx * delx + dely * dely + delz * delz;
+      const V3 d12 = {x[p][0] - x[q][0], x[p][1] - x[q][1], x[p][2] - x[q][2]};
+      const double rsq = JKRDT::dot(d12, d12);
       const double radsum = radius[p] + radius[q];
       if (!bonded && rsq > radsum * radsum) continue;
 
@@ -256,129 +259,75 @@ void PairJKRDT::compute(int eflag, int vflag)
       if (!std::isfinite(delta) || r == 0.0) report_blow_up(p, q, r);
 
       const Param &P = par(type[p], type[q]);
-      // the scales depend on the radii and the type pair only: reuse the last ones
       if (&P != last_param || radius[p] != last_r1 || radius[q] != last_r2) {
-        S = JKRDT::normal_scales(radius[p], radius[q], P.gamma, P.a0_coef);
+        K = JKRDT::contact_constants(P, radius[p], radius[q]);
         last_param = &P;
         last_r1 = radius[p];
         last_r2 = radius[q];
       }
 
-      double *state = dnum ? C.slot_values + (bigint) s * dnum : nullptr;
-      const double rinv = 1.0 / r;
-      // normal relative velocity at the half step, > 0 when separating
-      const double vn = ((v[p][0] - v[q][0]) * delx + (v[p][1] - v[q][1]) * dely +
-                         (v[p][2] - v[q][2]) * delz) * rinv;
+      JKRDT::ContactMotion m;
+      m.d12 = d12;
+      m.r = r;
+      m.v12 = JKRDT::vec(v[p]) - JKRDT::vec(v[q]);
+      m.w1 = JKRDT::vec(omega[p]);
+      m.w2 = JKRDT::vec(omega[q]);
+      m.vn = JKRDT::dot(m.v12, d12) / r;    // at the half step, > 0 when separating
 
       // a step must resolve the contact: name a pair too fast for the list
-      const double step = std::fabs(vn) * dt;
-      if (step > half_skin) report_fast_pair(p, q, vn);
-      if (!setup) step_max = std::max(step_max, step / S.delta_c);
+      const double step = std::fabs(m.vn) * dt;
+      if (step > half_skin) report_fast_pair(p, q, m.vn);
+      if (!setup) step_max = std::max(step_max, step / K.S.delta_c);
 
-      if (bonded && delta < -S.delta_c) {
-        // separation (section 2.1): U_n drops to 0 from its value at the last step
-        if (!setup) {
-          book(Contacts::FORM_BREAK, breaking_loss(delta, vn, dt, S), p, q, nlocal);
-          if (P.damp_coef > 0.0)
-            book(Contacts::DAMPING, 0.5 * dt * state[off_fd] * vn, p, q, nlocal);
-        }
-        if (P.tangential())
-          tangential_step(p, q, P, S, state, false, true, {delx, dely, delz}, r, load);
+      const bool formed = !bonded;    // delta >= 0 here: contact formation (section 2.1)
+      if (formed && setup) check_initial_overlap(p, q, delta, K.S);
+      // a contact forms within the step that closes the gap: deeper means it was missed
+      if (formed && !setup && delta > 2.0 * step + LATE_SLACK * K.S.delta_c)
+        report_late_contact(p, q, delta, step, K.S);
+
+      double *state = layout.dnum ? slot_values + (bigint) s * layout.dnum : nullptr;
+      JKRDT::contact_step(K, layout, m, delta, dt, setup, formed, eflag, state, out);
+      if (!setup) book(out.loss, p, q, nlocal);
+      if (out.broken) {
         bonded_slot[s] = 0;
         continue;
       }
-
-      const bool formed = !bonded;    // delta >= 0 here: contact formation (section 2.1)
-      if (formed && setup) check_initial_overlap(p, q, delta, S);
-      // a contact forms within the step that closes the gap: deeper means it was missed
-      if (formed && !setup && delta > 2.0 * step + LATE_SLACK * S.delta_c)
-        report_late_contact(p, q, delta, step, S);
-      if (formed) {
-        bonded_slot[s] = 1;
-        if (state) std::fill(state, state + dnum, 0.0);
-      }
-
-      const double y = JKRDT::contact_sqrt_radius(delta / S.delta0);    // eq. (4)
-      double fmag = S.F_c * JKRDT::normal_force_ratio(y);               // eq. (5)
-      double u_n = 0.0;
-      if (eflag || (formed && !setup))
-        u_n = S.F_c * S.delta_c * JKRDT::normal_potential_ratio(y);    // eq. (6)
-      if (formed && !setup)
-        book(Contacts::FORM_BREAK, JKRDT::event_loss(0.0, u_n, fmag, vn, dt), p, q, nlocal);
-
-      if (P.damp_coef > 0.0) {
-        // eq. (A.5); a run's first evaluation reuses the stored F_D, so that a
-        // continued run equals an uninterrupted one
-        const double fd_prev = formed ? 0.0 : state[off_fd];
-        const double fd = (setup && !formed) ? fd_prev : P.damp_coef * y * y * S.a0 * vn;
-        if (!setup) book(Contacts::DAMPING, 0.5 * dt * (fd_prev + fd) * vn, p, q, nlocal);
-        state[off_fd] = fd;
-        fmag -= fd;
-      }
+      bonded_slot[s] = 1;
 
       // force on p: normal (eq. 5 and A.5) plus sliding (eq. 14); torques eqs. (17), (23), (27)
-      const double fpair = fmag * rinv;
-      JKRDT::V3 fp = {delx * fpair, dely * fpair, delz * fpair};
-      double u_t = 0.0;
-      if (P.tangential()) {
-        tangential_step(p, q, P, S, state, formed, false, {delx, dely, delz}, r, load);
-        JKRDT::V3 mp = {0.0, 0.0, 0.0}, mq = mp;
-        for (int ch = 0; ch < JKRDT::NCHANNEL; ch++) {
-          fp = fp + load[ch].F1;
-          mp = mp + load[ch].M1;
-          mq = mq + load[ch].M2;
-          u_t += load[ch].U;
-        }
-        if (p_own) {
-          torque[p][0] += mp.x;
-          torque[p][1] += mp.y;
-          torque[p][2] += mp.z;
-        }
-        if (q_own) {
-          torque[q][0] += mq.x;
-          torque[q][1] += mq.y;
-          torque[q][2] += mq.z;
-        }
-      }
+      const V3 &fp = out.F1;
       if (!std::isfinite(fp.x + fp.y + fp.z)) report_not_finite(p, q, "force");
-      const double share = 0.5 * ((p_own ? 1.0 : 0.0) + (q_own ? 1.0 : 0.0));
+      const bool p_own = p < nlocal, q_own = q < nlocal;
       if (p_own) {
         f[p][0] += fp.x;
         f[p][1] += fp.y;
         f[p][2] += fp.z;
+        torque[p][0] += out.M1.x;
+        torque[p][1] += out.M1.y;
+        torque[p][2] += out.M1.z;
       }
       if (q_own) {
         f[q][0] -= fp.x;
         f[q][1] -= fp.y;
         f[q][2] -= fp.z;
+        torque[q][0] += out.M2.x;
+        torque[q][1] += out.M2.y;
+        torque[q][2] += out.M2.z;
       }
+      const double share = 0.5 * ((p_own ? 1.0 : 0.0) + (q_own ? 1.0 : 0.0));
       contacts += share;
       if (eflag) {
-        upot += share * u_n;
-        if (P.tangential())
-          for (int ch = 0; ch < JKRDT::NCHANNEL; ch++) utan[ch] += share * load[ch].U;
+        upot += share * out.U_n;
+        for (int ch = 0; ch < JKRDT::NCHANNEL; ch++) utan[ch] += share * out.U[ch];
       }
-      if (evflag) ev_tally_xyz(p, q, nlocal, 0, u_n + u_t, 0.0, fp.x, fp.y, fp.z, delx, dely, delz);
+      if (evflag)
+        ev_tally_xyz(p, q, nlocal, 0, out.U_n + out.U[0] + out.U[1] + out.U[2], 0.0, fp.x, fp.y,
+                     fp.z, d12.x, d12.y, d12.z);
     }
   }
 
   C.rows_changed();
   if (eflag_global) fill_pvector(upot, utan, contacts);
-}
-
-/* ----------------------------------------------------------------------
-   loss at separation: the contact was last evaluated one step earlier, at
-   delta_prev = delta + vn dt (straight-line relative motion over the step),
-   held no further than the break point -delta_c
-------------------------------------------------------------------------- */
-
-double PairJKRDT::breaking_loss(double delta, double vn, double dt, const JKRDT::NormalScales &S)
-{
-  const double delta_prev = std::max(delta + vn * dt, -S.delta_c);
-  const double y = JKRDT::contact_sqrt_radius(delta_prev / S.delta0);
-  const double u_prev = S.F_c * S.delta_c * JKRDT::normal_potential_ratio(y);
-  const double f_prev = S.F_c * JKRDT::normal_force_ratio(y);
-  return JKRDT::event_loss(u_prev, 0.0, f_prev, vn, dt);
 }
 
 /* ----------------------------------------------------------------------
@@ -424,7 +373,8 @@ bool PairJKRDT::bonded_contact(int i, int j, ContactView &view) const
   const double dx = x[p][0] - x[q][0], dy = x[p][1] - x[q][1], dz = x[p][2] - x[q][2];
   const double r = std::sqrt(dx * dx + dy * dy + dz * dz);
   const Param &P = par(atom->type[p], atom->type[q]);
-  const auto S = JKRDT::normal_scales(atom->radius[p], atom->radius[q], P.gamma, P.a0_coef);
+  const auto K = JKRDT::contact_constants(P, atom->radius[p], atom->radius[q]);
+  const auto &S = K.S;
   view.id1 = tag[p];
   view.id2 = tag[q];
   view.delta = atom->radius[p] + atom->radius[q] - r;
@@ -435,7 +385,7 @@ bool PairJKRDT::bonded_contact(int i, int j, ContactView &view) const
   if (P.damp_coef > 0.0) view.force -= C.contact_values(i, k)[C.offset(Contacts::DAMPING_FORCE)];
   view.zeta = view.xi = view.phi = 0.0;
   JKRDT::ContactState c;
-  if (P.tangential() && read_state(C.contact_values(i, k), c)) {
+  if (P.tangential() && JKRDT::load_state(C.contact_values(i, k), C.layout(), c)) {
     const JKRDT::V3 nc = JKRDT::unit({dx, dy, dz});
     if (P.sliding)
       view.zeta = JKRDT::norm(JKRDT::tangential_part(

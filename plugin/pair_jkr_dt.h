@@ -12,8 +12,7 @@
 
 #include "pair.h"
 
-#include "jkr_dt_normal.h"
-#include "jkr_dt_tangential.h"
+#include "jkr_dt_contact.h"
 
 #include <string>
 #include <vector>
@@ -31,24 +30,15 @@ class PairJKRDT : public Pair {
     int sliding, rolling, twisting;
   };
 
-  // the parameters of one type pair after defaults and mixing
-  struct Param {
-    double gamma;       // surface energy
+  // the parameters of one type pair after defaults and mixing: the kernel's
+  // coefficients (jkr_dt_contact.h) and what they were made from
+  struct Param : JKRDT::Coefficients {
     double Estar;       // reduced Young's modulus, eq. (2)
     double Gstar;       // G* of the sliding stiffness, eq. (13)
     double Gred;        // reduced shear modulus (1/G1 + 1/G2)^-1 of eqs. (26), (35), (37)
     double nu;          // Poisson ratio in the damping of eq. (A.5)
-    double xi_crit;     // critical rolling displacement (NaN if rolling is off)
     double tvis;        // viscoelastic time scale of eq. (A.5)
-    double a0_coef;     // (9 pi gamma / E*)^(1/3): a0 = a0_coef R^(2/3)
-    double damp_coef;   // 2 tvis E* / nu^2: F_D = damp_coef a v_rel
     double cut;         // reach of a stretched contact between the largest radii
-    int sliding, rolling, twisting;
-    double ks_coef;     // k_s / a0 = 8 G* (times ks_scale), eq. (12)
-    double zeta_coef;   // zeta_crit / a0 = Gred / (16 pi G*), eqs. (35)-(36)
-    double k_r;         // 4 F_c / R = 12 pi gamma (times kr_scale), eq. (22)
-    double kt_coef;     // k_t / a0^3 = 16/3 Gred (times kt_scale), eq. (26)
-    bool tangential() const { return sliding || rolling || twisting; }
   };
 
   // one bonded contact, as the local compute reports it
@@ -119,12 +109,6 @@ class PairJKRDT : public Pair {
 
   void allocate();
   Param resolve(int i, int j) const;
-  JKRDT::Tangential tangential_constants(const Param &P, const JKRDT::NormalScales &S) const;
-  bool read_state(const double *values, JKRDT::ContactState &c) const;
-  void write_state(double *values, const JKRDT::ContactState &c) const;
-  void tangential_step(int p, int q, const Param &P, const JKRDT::NormalScales &S,
-                       double *state, bool formed, bool breaking,
-                       const JKRDT::V3 &d12, double dist, JKRDT::ChannelLoad load[JKRDT::NCHANNEL]);
   int layout_mask() const;
   void book_channels_switched_off(const std::vector<Param> &fresh, FixJKRDTContacts &C);
   void find_max_radii();
@@ -142,8 +126,7 @@ class PairJKRDT : public Pair {
   [[noreturn]] void report_late_contact(int p, int q, double delta, double step,
                                         const JKRDT::NormalScales &S) const;
   [[noreturn]] void report_not_finite(int p, int q, const char *what) const;
-  void book(int channel, double energy, int p, int q, int nlocal);
-  static double breaking_loss(double delta, double vn, double dt, const JKRDT::NormalScales &S);
+  void book(const double loss[JKRDT::NLOSS], int p, int q, int nlocal);
   void fill_pvector(double upot, const double *utan, double contacts);
 };
 

