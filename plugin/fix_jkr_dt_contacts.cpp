@@ -21,10 +21,6 @@
 using namespace LAMMPS_NS;
 
 static constexpr int INITIAL_CAPACITY = 8;
-static_assert(FixJKRDTContacts::NLEDGER == JKRDT::NLOSS &&
-                  FixJKRDTContacts::FORM_BREAK == JKRDT::LOSS_FORM_BREAK &&
-                  FixJKRDTContacts::TWISTING == JKRDT::LOSS_TWISTING,
-              "the ledger's columns are the kernel's loss channels");
 
 /* ---------------------------------------------------------------------- */
 

@@ -57,8 +57,15 @@ class FixJKRDTContacts : public Fix {
   enum Field { DAMPING_FORCE = 0, POINTERS, TWIST, NFIELD };
   static constexpr int FIELD_SIZE[NFIELD] = {1, 6, 1};
 
-  // ledger columns: energy dissipated by channel
-  enum Ledger { FORM_BREAK = 0, DAMPING, SLIDING, ROLLING, TWISTING, NLEDGER };
+  // ledger columns: energy dissipated by channel, the kernel's loss channels
+  enum Ledger {
+    FORM_BREAK = JKRDT::LOSS_FORM_BREAK,
+    DAMPING = JKRDT::LOSS_DAMPING,
+    SLIDING = JKRDT::LOSS_SLIDING,
+    ROLLING = JKRDT::LOSS_ROLLING,
+    TWISTING = JKRDT::LOSS_TWISTING,
+    NLEDGER = JKRDT::NLOSS
+  };
 
   FixJKRDTContacts(class LAMMPS *, int, char **);
   ~FixJKRDTContacts() override;

@@ -43,9 +43,13 @@
 #include "neigh_list.h"
 #include "neighbor.h"
 #include "update.h"
+#include "utils.h"
 
 #include <algorithm>
 #include <cmath>
+#if defined(_OPENMP)
+#include <omp.h>
+#endif
 
 using namespace LAMMPS_NS;
 using Contacts = FixJKRDTContacts;
@@ -55,7 +59,7 @@ const char *const PairJKRDT::FIX_ID = "JKR_DT_CONTACTS";
 /* ---------------------------------------------------------------------- */
 
 PairJKRDT::PairJKRDT(LAMMPS *lmp) :
-    Pair(lmp), fix_contacts(nullptr), nstride(0),
+    Pair(lmp), fix_contacts(nullptr), threads_logged(0), nstride(0),
     dt_check(DT_CHECK_ERROR), tc_min(0.0), tc_types{0, 0}, tc_logged(0.0), dt_logged(0.0),
     dt_warned(0.0), checked_laststep(-1), step_max(0.0),
     step_warned(false), contacts_at_run_end(0), data_contacts(0)
@@ -129,6 +133,17 @@ void PairJKRDT::init_style()
 
   neighbor->add_request(this, NeighConst::REQ_NEWTON_OFF);
 
+  const int nthreads = nthreads_used();
+  if (comm->me == 0 && nthreads != threads_logged)
+    utils::logmesg(lmp, "pair jkr/dt: {} OpenMP thread{} per rank\n", nthreads,
+                   nthreads > 1 ? "s" : "");
+  threads_logged = nthreads;
+#if !defined(_OPENMP)
+  if (comm->me == 0 && comm->nthreads > 1)
+    error->warning(FLERR, "pair jkr/dt was built without OpenMP: it runs on 1 thread of the {} "
+                          "asked for; rebuild with an OpenMP compiler", comm->nthreads);
+#endif
+
   auto *fix = modify->get_fix_by_id(FIX_ID);
   if (!fix && fix_contacts && contacts_at_run_end > 0)
     error->all(FLERR,
@@ -182,30 +197,114 @@ void PairJKRDT::check_periodic_images(double cutmax)
 }
 
 /* ----------------------------------------------------------------------
-   half of a contact's dissipation goes to each of its owned atoms
+   threads: comm->nthreads (OMP_NUM_THREADS, package omp N, -sf omp). The
+   neighbor list's atoms are cut into one contiguous range per thread, so a
+   contact's slot belongs to one thread; forces, torques and the ledger of
+   threads 1.. go to buffers summed into the atoms' arrays in thread order.
+   Per-atom energy or virial tallies run on one thread.
 ------------------------------------------------------------------------- */
 
-void PairJKRDT::book(const double loss[JKRDT::NLOSS], int p, int q, int nlocal)
+int PairJKRDT::nthreads_used() const
 {
-  for (int l = 0; l < JKRDT::NLOSS; l++) {
-    if (loss[l] == 0.0) continue;
-    if (p < nlocal) fix_contacts->ledger[p][l] += 0.5 * loss[l];
-    if (q < nlocal) fix_contacts->ledger[q][l] += 0.5 * loss[l];
-  }
+#if defined(_OPENMP)
+  return std::max(1, comm->nthreads);
+#else
+  return 1;
+#endif
 }
-
-/* ---------------------------------------------------------------------- */
 
 void PairJKRDT::compute(int eflag, int vflag)
 {
-  using JKRDT::V3;
   ev_init(eflag, vflag);
+  if (update->laststep != checked_laststep) {    // once per run, 'run N pre no' included
+    checked_laststep = update->laststep;
+    check_time_step();
+  }
+  Contacts &C = *fix_contacts;
+  if (!C.slots_follow(list)) C.to_slots(list);    // a list built without post_neighbor
 
+  const int inum = list->inum;
+  const int nall = atom->nlocal + atom->nghost;
+  const bool tally_atoms = eflag_atom || vflag_atom;
+  const int nthreads = (tally_atoms || inum < 64) ? 1 : nthreads_used();
+  std::vector<Accumulator> acc(nthreads);
+  if ((int) thread_buffers.size() < nthreads - 1) thread_buffers.resize(nthreads - 1);
+  for (int t = 0; t < nthreads; t++) {
+    Accumulator &a = acc[t];
+    if (t == 0) {
+      a.f = atom->f[0];
+      a.torque = atom->torque[0];
+      a.ledger = atom->nlocal ? C.ledger[0] : nullptr;
+    } else {
+      std::vector<double> &buf = thread_buffers[t - 1];
+      buf.assign((std::size_t) nall * 6 + (std::size_t) atom->nlocal * JKRDT::NLOSS, 0.0);
+      a.f = buf.data();
+      a.torque = a.f + (std::size_t) nall * 3;
+      a.ledger = a.torque + (std::size_t) nall * 3;
+    }
+    a.upot = a.contacts = a.eng = a.step_max = 0.0;
+    std::fill(a.utan, a.utan + JKRDT::NCHANNEL, 0.0);
+    std::fill(a.virial, a.virial + 6, 0.0);
+  }
+
+  if (nthreads == 1) {
+    pair_loop(0, inum, eflag, tally_atoms, acc[0]);
+  } else {
+#if defined(_OPENMP)
+#pragma omp parallel num_threads(nthreads)
+    {
+      const int t = omp_get_thread_num();
+      const int from = (int) ((bigint) inum * t / nthreads);
+      const int to = (int) ((bigint) inum * (t + 1) / nthreads);
+      pair_loop(from, to, eflag, false, acc[t]);
+    }
+#endif
+    // sum the buffers of threads 1.. in order: the same partition gives the same sums
+    double *f = atom->f[0], *tq = atom->torque[0];
+    double *ledger = atom->nlocal ? C.ledger[0] : nullptr;
+    for (int t = 1; t < nthreads; t++) {
+      const Accumulator &a = acc[t];
+      for (int k = 0; k < 3 * nall; k++) {
+        f[k] += a.f[k];
+        tq[k] += a.torque[k];
+      }
+      for (int k = 0; k < atom->nlocal * JKRDT::NLOSS; k++) ledger[k] += a.ledger[k];
+    }
+  }
+
+  Accumulator total = acc[0];
+  for (int t = 0; t < nthreads; t++) {
+    if (acc[t].trouble.kind != Trouble::NONE) report(acc[t].trouble);
+    if (t == 0) continue;
+    total.upot += acc[t].upot;
+    total.contacts += acc[t].contacts;
+    total.eng += acc[t].eng;
+    total.step_max = std::max(total.step_max, acc[t].step_max);
+    for (int ch = 0; ch < JKRDT::NCHANNEL; ch++) total.utan[ch] += acc[t].utan[ch];
+    for (int k = 0; k < 6; k++) total.virial[k] += acc[t].virial[k];
+  }
+  step_max = std::max(step_max, total.step_max);
+  if (!tally_atoms) {
+    if (eflag_global) eng_vdwl += total.eng;
+    if (vflag_global)
+      for (int k = 0; k < 6; k++) virial[k] += total.virial[k];
+  }
+  C.rows_changed();
+  if (eflag_global) fill_pvector(total.upot, total.utan, total.contacts);
+}
+
+/* ----------------------------------------------------------------------
+   the pair loop over ilist entries [ii_from, ii_to): each pair in its
+   canonical orientation (p has the smaller ID) through contact_step();
+   half of a contact's dissipation goes to each of its owned atoms
+------------------------------------------------------------------------- */
+
+void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, Accumulator &acc)
+{
+  using JKRDT::V3;
   double **x = atom->x;
   double **v = atom->v;
   double **omega = atom->omega;
-  double **f = atom->f;
-  double **torque = atom->torque;
   const double *radius = atom->radius;
   const tagint *tag = atom->tag;
   const int *type = atom->type;
@@ -213,31 +312,31 @@ void PairJKRDT::compute(int eflag, int vflag)
   const bool setup = update->setupflag;
   const double dt = update->dt;
   const double half_skin = 0.5 * neighbor->skin;
-
-  if (update->laststep != checked_laststep) {    // once per run, 'run N pre no' included
-    checked_laststep = update->laststep;
-    check_time_step();
-  }
+  double *const f = acc.f, *const tq = acc.torque, *const ledger = acc.ledger;
 
   Contacts &C = *fix_contacts;
-  if (!C.slots_follow(list)) C.to_slots(list);    // a list built without post_neighbor
   const JKRDT::StateLayout layout = C.layout();
   unsigned char *const bonded_slot = C.bonded;
   double *const slot_values = C.slot_values;
+  const int *ilist = list->ilist;
+  const int *numneigh = list->numneigh;
+  int **firstneigh = list->firstneigh;
 
   // the constants depend on the type pair and the radii only: reuse the last ones
   JKRDT::ContactConstants K{};
   const Param *last_param = nullptr;
   double last_r1 = -1.0, last_r2 = -1.0;
-  double upot = 0.0, contacts = 0.0;
-  double utan[JKRDT::NCHANNEL] = {0.0, 0.0, 0.0};
   JKRDT::ContactResult out;
-  const int inum = list->inum;
-  const int *ilist = list->ilist;
-  const int *numneigh = list->numneigh;
-  int **firstneigh = list->firstneigh;
+  auto trouble = [&](Trouble::Kind kind, int p, int q, double a, double b) {
+    acc.trouble.kind = kind;
+    acc.trouble.p = p;
+    acc.trouble.q = q;
+    acc.trouble.a = a;
+    acc.trouble.b = b;
+    acc.trouble.S = K.S;
+  };
 
-  for (int ii = 0; ii < inum; ii++) {
+  for (int ii = ii_from; ii < ii_to; ii++) {
     const int i = ilist[ii];
     const int *jlist = firstneigh[i];
     int s = C.slot_first[ii];
@@ -256,7 +355,7 @@ void PairJKRDT::compute(int eflag, int vflag)
 
       const double r = std::sqrt(rsq);
       const double delta = radsum - r;    // eq. (3)
-      if (!std::isfinite(delta) || r == 0.0) report_blow_up(p, q, r);
+      if (!std::isfinite(delta) || r == 0.0) return trouble(Trouble::BLOW_UP, p, q, r, 0.0);
 
       const Param &P = par(type[p], type[q]);
       if (&P != last_param || radius[p] != last_r1 || radius[q] != last_r2) {
@@ -276,18 +375,25 @@ void PairJKRDT::compute(int eflag, int vflag)
 
       // a step must resolve the contact: name a pair too fast for the list
       const double step = std::fabs(m.vn) * dt;
-      if (step > half_skin) report_fast_pair(p, q, m.vn);
-      if (!setup) step_max = std::max(step_max, step / K.S.delta_c);
+      if (step > half_skin) return trouble(Trouble::FAST_PAIR, p, q, m.vn, 0.0);
+      if (!setup) acc.step_max = std::max(acc.step_max, step / K.S.delta_c);
 
       const bool formed = !bonded;    // delta >= 0 here: contact formation (section 2.1)
-      if (formed && setup) check_initial_overlap(p, q, delta, K.S);
+      if (formed && setup && delta >= std::min(radius[p], radius[q]))
+        return trouble(Trouble::OVERLAP, p, q, delta, 0.0);
       // a contact forms within the step that closes the gap: deeper means it was missed
       if (formed && !setup && delta > 2.0 * step + LATE_SLACK * K.S.delta_c)
-        report_late_contact(p, q, delta, step, K.S);
+        return trouble(Trouble::LATE, p, q, delta, step);
 
       double *state = layout.dnum ? slot_values + (bigint) s * layout.dnum : nullptr;
       JKRDT::contact_step(K, layout, m, delta, dt, setup, formed, eflag, state, out);
-      if (!setup) book(out.loss, p, q, nlocal);
+      const bool p_own = p < nlocal, q_own = q < nlocal;
+      if (!setup)
+        for (int l = 0; l < JKRDT::NLOSS; l++) {
+          if (out.loss[l] == 0.0) continue;
+          if (p_own) ledger[p * JKRDT::NLOSS + l] += 0.5 * out.loss[l];
+          if (q_own) ledger[q * JKRDT::NLOSS + l] += 0.5 * out.loss[l];
+        }
       if (out.broken) {
         bonded_slot[s] = 0;
         continue;
@@ -296,38 +402,47 @@ void PairJKRDT::compute(int eflag, int vflag)
 
       // force on p: normal (eq. 5 and A.5) plus sliding (eq. 14); torques eqs. (17), (23), (27)
       const V3 &fp = out.F1;
-      if (!std::isfinite(fp.x + fp.y + fp.z)) report_not_finite(p, q, "force");
-      const bool p_own = p < nlocal, q_own = q < nlocal;
+      if (!std::isfinite(fp.x + fp.y + fp.z)) return trouble(Trouble::NOT_FINITE, p, q, 0, 0);
       if (p_own) {
-        f[p][0] += fp.x;
-        f[p][1] += fp.y;
-        f[p][2] += fp.z;
-        torque[p][0] += out.M1.x;
-        torque[p][1] += out.M1.y;
-        torque[p][2] += out.M1.z;
+        f[3 * p] += fp.x;
+        f[3 * p + 1] += fp.y;
+        f[3 * p + 2] += fp.z;
+        tq[3 * p] += out.M1.x;
+        tq[3 * p + 1] += out.M1.y;
+        tq[3 * p + 2] += out.M1.z;
       }
       if (q_own) {
-        f[q][0] -= fp.x;
-        f[q][1] -= fp.y;
-        f[q][2] -= fp.z;
-        torque[q][0] += out.M2.x;
-        torque[q][1] += out.M2.y;
-        torque[q][2] += out.M2.z;
+        f[3 * q] -= fp.x;
+        f[3 * q + 1] -= fp.y;
+        f[3 * q + 2] -= fp.z;
+        tq[3 * q] += out.M2.x;
+        tq[3 * q + 1] += out.M2.y;
+        tq[3 * q + 2] += out.M2.z;
       }
       const double share = 0.5 * ((p_own ? 1.0 : 0.0) + (q_own ? 1.0 : 0.0));
-      contacts += share;
+      acc.contacts += share;
+      if (!eflag && !vflag_either) continue;
+      const double u = out.U_n + out.U[0] + out.U[1] + out.U[2];
       if (eflag) {
-        upot += share * out.U_n;
-        for (int ch = 0; ch < JKRDT::NCHANNEL; ch++) utan[ch] += share * out.U[ch];
+        acc.upot += share * out.U_n;
+        for (int ch = 0; ch < JKRDT::NCHANNEL; ch++) acc.utan[ch] += share * out.U[ch];
       }
-      if (evflag)
-        ev_tally_xyz(p, q, nlocal, 0, out.U_n + out.U[0] + out.U[1] + out.U[2], 0.0, fp.x, fp.y,
-                     fp.z, d12.x, d12.y, d12.z);
+      if (tally_atoms) {
+        ev_tally_xyz(p, q, nlocal, 0, u, 0.0, fp.x, fp.y, fp.z, d12.x, d12.y, d12.z);
+        continue;
+      }
+      // ev_tally_xyz with newton off, by hand: thread-safe into this thread's sums
+      if (eflag_global) acc.eng += share * u;
+      if (vflag_global) {
+        acc.virial[0] += share * d12.x * fp.x;
+        acc.virial[1] += share * d12.y * fp.y;
+        acc.virial[2] += share * d12.z * fp.z;
+        acc.virial[3] += share * d12.x * fp.y;
+        acc.virial[4] += share * d12.x * fp.z;
+        acc.virial[5] += share * d12.y * fp.z;
+      }
     }
   }
-
-  C.rows_changed();
-  if (eflag_global) fill_pvector(upot, utan, contacts);
 }
 
 /* ----------------------------------------------------------------------

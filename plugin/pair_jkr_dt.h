@@ -120,13 +120,30 @@ class PairJKRDT : public Pair {
   void warn_data_file() const;
   void find_contact_time();
   void check_time_step();
-  void check_initial_overlap(int p, int q, double delta, const JKRDT::NormalScales &S) const;
+  [[noreturn]] void report_overlap(int p, int q, double delta, const JKRDT::NormalScales &S) const;
   [[noreturn]] void report_blow_up(int p, int q, double r) const;
   [[noreturn]] void report_fast_pair(int p, int q, double vn) const;
   [[noreturn]] void report_late_contact(int p, int q, double delta, double step,
                                         const JKRDT::NormalScales &S) const;
   [[noreturn]] void report_not_finite(int p, int q, const char *what) const;
-  void book(const double loss[JKRDT::NLOSS], int p, int q, int nlocal);
+  // what one thread's share of the pair loop adds up (thread 0 writes to the atoms' own
+  // arrays, the others to buffers summed after the loop in thread order)
+  struct Trouble {
+    enum Kind { NONE = 0, BLOW_UP, FAST_PAIR, OVERLAP, LATE, NOT_FINITE } kind = NONE;
+    int p = 0, q = 0;
+    double a = 0.0, b = 0.0;
+    JKRDT::NormalScales S{};
+  };
+  struct Accumulator {
+    double *f, *torque, *ledger;    // 3, 3 and NLOSS values per atom, flat
+    double upot, contacts, utan[JKRDT::NCHANNEL], eng, virial[6], step_max;
+    Trouble trouble;                // the first problem met; the thread stops there
+  };
+  void pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, Accumulator &acc);
+  [[noreturn]] void report(const Trouble &t) const;
+  int nthreads_used() const;
+  std::vector<std::vector<double>> thread_buffers;    // per extra thread: f, torque, ledger
+  int threads_logged;          // threads per rank last written to the log
   void fill_pvector(double upot, const double *utan, double contacts);
 };
 

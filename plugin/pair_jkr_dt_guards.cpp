@@ -178,19 +178,34 @@ void PairJKRDT::check_time_step()
 }
 
 /* ----------------------------------------------------------------------
-   a contact found when a run starts: overlapping input is named as such
+   a contact found when a run starts deeper than the smaller radius:
+   overlapping input is named as such
 ------------------------------------------------------------------------- */
 
-void PairJKRDT::check_initial_overlap(int p, int q, double delta,
-                                      const JKRDT::NormalScales &S) const
+void PairJKRDT::report_overlap(int p, int q, double delta, const JKRDT::NormalScales &S) const
 {
   const double rmin = std::min(atom->radius[p], atom->radius[q]);
-  if (delta >= rmin)
-    error->one(FLERR,
-               "pair jkr/dt: atoms {} and {} overlap by {:.4g} ({:.3g} of the smaller radius) "
-               "in the input: one sits inside the other. Overlapping input: move them apart "
-               "(the builders place bonded grains at r1 + r2 - delta0, delta0 = {:.4g})",
-               atom->tag[p], atom->tag[q], delta, delta / rmin, S.delta0);
+  error->one(FLERR,
+             "pair jkr/dt: atoms {} and {} overlap by {:.4g} ({:.3g} of the smaller radius) "
+             "in the input: one sits inside the other. Overlapping input: move them apart "
+             "(the builders place bonded grains at r1 + r2 - delta0, delta0 = {:.4g})",
+             atom->tag[p], atom->tag[q], delta, delta / rmin, S.delta0);
+}
+
+/* ----------------------------------------------------------------------
+   the problem a thread of the pair loop met, named
+------------------------------------------------------------------------- */
+
+void PairJKRDT::report(const Trouble &t) const
+{
+  switch (t.kind) {
+    case Trouble::BLOW_UP: report_blow_up(t.p, t.q, t.a);
+    case Trouble::FAST_PAIR: report_fast_pair(t.p, t.q, t.a);
+    case Trouble::OVERLAP: report_overlap(t.p, t.q, t.a, t.S);
+    case Trouble::LATE: report_late_contact(t.p, t.q, t.a, t.b, t.S);
+    case Trouble::NOT_FINITE: report_not_finite(t.p, t.q, "force");
+    default: error->one(FLERR, "pair jkr/dt: unknown trouble (internal error)");
+  }
 }
 
 /* ---------------------------------------------------------------------- */

