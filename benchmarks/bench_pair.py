@@ -169,7 +169,7 @@ def main(argv=None):
                         help="where the scenes are built once and kept (default: %(default)s)")
     parser.add_argument("--quick", action="store_true",
                         help="2 x 500 grains, 1e6 atom-steps, one repeat: a check that it runs")
-    parser.add_argument("--out", type=Path, default=Path("benchmarks/results/bench.json"))
+    parser.add_argument("--out", type=Path, default=Path("benchmarks/speed/bench.json"))
     args = parser.parse_args(argv)
     if args.quick:
         args.sizes, args.atom_steps, args.repeat = [500], 1e6, 1

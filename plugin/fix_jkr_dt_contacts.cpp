@@ -430,6 +430,7 @@ void FixJKRDTContacts::grow_arrays(int nmax)
 
 void FixJKRDTContacts::copy_arrays(int i, int j, int /*delflag*/)
 {
+  to_rows();    // atoms are about to be moved (sort, deletion): the rows take the state first
   npartner[j] = npartner[i];
   std::copy_n(partner[i], npartner[i], partner[j]);
   if (dnum) std::copy_n(values[i], npartner[i] * dnum, values[j]);
@@ -450,6 +451,7 @@ void FixJKRDTContacts::set_arrays(int i)
 
 int FixJKRDTContacts::pack_exchange(int i, double *buf)
 {
+  to_rows();    // also when another fix migrates atoms before this fix's pre_exchange
   int m = 0;
   buf[m++] = npartner[i];
   for (int k = 0; k < npartner[i]; k++) buf[m++] = ubuf(partner[i][k]).d;
@@ -479,6 +481,7 @@ int FixJKRDTContacts::unpack_exchange(int nlocal, double *buf)
 
 int FixJKRDTContacts::pack_restart(int i, double *buf)
 {
+  to_rows();
   int m = 1;
   buf[m++] = mask;
   m += pack_exchange(i, &buf[m]);
@@ -517,12 +520,14 @@ void FixJKRDTContacts::unpack_restart(int nlocal, int nth)
 
 int FixJKRDTContacts::size_restart(int i)
 {
+  to_rows();    // a restart file written during a run: the rows take the state first
   return 4 + npartner[i] * (1 + dnum) + NLEDGER;
 }
 
 // called on every rank by write_restart, so it may reduce over ranks
 int FixJKRDTContacts::maxsize_restart()
 {
+  to_rows();
   int nmine = 0, nall = 0;
   for (int i = 0; i < atom->nlocal; i++) nmine = std::max(nmine, npartner[i]);
   MPI_Allreduce(&nmine, &nall, 1, MPI_INT, MPI_MAX, world);

