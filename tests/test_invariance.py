@@ -52,7 +52,9 @@ def run_deck(workdir, data, model, nproc=1, steps=STEPS, restart=None, extra=(),
         cmd += ["-var", "read", "read_restart"]
     if nproc > 1:
         cmd = [str(BIN / "mpirun"), "-np", str(nproc)] + cmd
-    env = dict(os.environ, OMP_NUM_THREADS=str(threads))
+    # threads that sleep while they wait: more threads than cores (2 ranks x 2 threads on
+    # 2 cores) would otherwise spin against each other
+    env = dict(os.environ, OMP_NUM_THREADS=str(threads), OMP_WAIT_POLICY="PASSIVE")
     subprocess.run(cmd, check=True, cwd=workdir, timeout=600, env=env)
     final = np.loadtxt(workdir / "final.dump", skiprows=9)
     return final[np.argsort(final[:, 0])]
