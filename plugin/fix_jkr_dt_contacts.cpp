@@ -20,7 +20,7 @@
 
 using namespace LAMMPS_NS;
 
-static constexpr int INITIAL_CAPACITY = 8;
+static constexpr int INITIAL_CAPACITY = 4;    // BPCA grains hold ~2 contacts; rows grow when one needs more
 
 /* ---------------------------------------------------------------------- */
 
