@@ -40,28 +40,18 @@ def write_data_after_a_run(tmp_path):
     return log, data
 
 
-def test_write_data_warns_and_a_run_from_it_is_refused(tmp_path):
+# decks give their own coefficients after read_data: the file's mark must outlive them
+@pytest.mark.parametrize("then", ["", "pair_coeff * * gamma 0.1 E 7e9 nu 0.25 frictionless"],
+                         ids=["coefficients from the file", "the deck's own pair_coeff"])
+def test_a_run_from_write_data_with_contacts_is_refused(tmp_path, then):
     log, data = write_data_after_a_run(tmp_path)
     assert "WARNING: pair jkr/dt: write_data does not carry the 1 bonded contacts" in \
         log.read_text()
     lmp = start_lammps()
     try:
-        lmp.commands_string(READ_BACK.format(data=data))
+        lmp.commands_string(READ_BACK.format(data=data) + then)
         with pytest.raises(Exception, match="written by write_data from a state with 1 bonded "
-                                            "contacts.*write_restart / read_restart"):
-            lmp.command("run 10")
-    finally:
-        lmp.close()
-
-
-def test_a_decks_own_pair_coeff_after_read_data_is_still_refused(tmp_path):
-    # decks give their own coefficients after read_data: the file's mark must outlive them
-    _, data = write_data_after_a_run(tmp_path)
-    lmp = start_lammps()
-    try:
-        lmp.commands_string(READ_BACK.format(data=data))
-        lmp.command("pair_coeff * * gamma 0.1 E 7e9 nu 0.25 frictionless")
-        with pytest.raises(Exception, match="1 bonded contacts.*write_restart / read_restart.*"
+                                            "contacts.*write_restart / read_restart.*"
                                             "'pair_style jkr/dt' again after read_data"):
             lmp.command("run 10")
     finally:
