@@ -128,6 +128,7 @@ inline void store_state(double *values, const StateLayout &L, const ContactState
 struct ContactMotion {
   V3 d12;        // x1 - x2
   double r;      // |x1 - x2|
+  double rinv;   // 1 / r
   V3 v12;        // v1 - v2 at the half step
   V3 w1, w2;     // omega1, omega2 at the half step
   double vn;     // v12 . d12 / r, > 0 when separating
@@ -169,7 +170,7 @@ inline void tangential_step(const ContactConstants &c, const StateLayout &L,
 {
   const Tangential &K = c.K;
   const double R = c.S.R;
-  const V3 nc = (1.0 / m.r) * m.d12;    // eq. (9)
+  const V3 nc = m.rinv * m.d12;    // eq. (9)
 
   ContactState before;
   const bool traced = !formed && load_state(state, L, before);
@@ -184,7 +185,7 @@ inline void tangential_step(const ContactConstants &c, const StateLayout &L,
       // (d12 - h) / |d12 - h| with h = (v1 - v2) dt/2, to first order in h / r
       // (the error, (h / r)^2 of one increment, is third order in dt)
       const V3 h = (0.5 * dt) * m.v12;
-      const V3 nc_half = ((1.0 + dot(nc, h) / m.r) / m.r) * (m.d12 - h);
+      const V3 nc_half = ((1.0 + dot(nc, h) * m.rinv) * m.rinv) * (m.d12 - h);
       now.phi += dt * dot(m.w1 - m.w2, nc_half);
     }
   }
@@ -194,8 +195,9 @@ inline void tangential_step(const ContactConstants &c, const StateLayout &L,
   if (breaking) {
     for (int ch = 0; ch < NCHANNEL; ch++) load[ch] = {0.0, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
   } else {
-    clamped = clamp_to_elastic_limits(now, nc, c.r1, c.r2, R, K);    // eqs. (42), (A8)
-    tangential_load(now, nc, m.r, c.r1, c.r2, R, K, load);           // eqs. (14)-(27)
+    Displacements d;                                                     // eqs. (8)-(20)
+    clamped = clamp_to_elastic_limits(now, nc, c.r1, c.r2, R, K, d);    // eqs. (42), (A8)
+    tangential_load(now, d, nc, m.r, c.r1, c.r2, R, K, load);           // eqs. (14)-(27)
   }
 
   if (traced && !setup && (breaking || clamped)) {
@@ -267,7 +269,7 @@ inline void contact_step(const ContactConstants &c, const StateLayout &L,
     state[L.fd] = fd;
     fmag -= fd;
   }
-  out.F1 = (fmag / m.r) * m.d12;
+  out.F1 = (fmag * m.rinv) * m.d12;
   if (c.tangential) tangential_step(c, L, m, dt, setup, formed, false, state, out);
 }
 

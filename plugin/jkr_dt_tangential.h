@@ -118,6 +118,23 @@ inline V3 tangential_part(const V3 &a, const V3 &nc) { return a - dot(a, nc) * n
 // xi = R (n1 + n2), eq. (20)
 inline V3 rolling_xi(const ContactState &c, double R) { return R * (c.n1 + c.n2); }
 
+// the displacements a state's loads and limits are made of, computed once per step
+struct Displacements {
+  V3 zeta0;    // eq. (8)
+  V3 zeta;     // eq. (10)
+  V3 xi;       // eq. (20)
+};
+
+inline Displacements displacements(const ContactState &c, const V3 &nc, double r1, double r2,
+                                   double R)
+{
+  Displacements d;
+  d.zeta0 = sliding_zeta0(c, nc, r1, r2);
+  d.zeta = tangential_part(d.zeta0, nc);
+  d.xi = rolling_xi(c, R);
+  return d;
+}
+
 /* ---------------------------------------------------------------------
    potentials, forces and torques of each channel, eqs. (11)-(27)
 ------------------------------------------------------------------------ */
@@ -130,17 +147,18 @@ struct ChannelLoad {
   V3 M1, M2;   // torques on particles 1 and 2, eqs. (17), (23), (27)
 };
 
-// nc = (x1 - x2) / dist, eq. (9)
-inline void tangential_load(const ContactState &c, const V3 &nc, double dist, double r1, double r2,
-                            double R, const Tangential &K, ChannelLoad load[NCHANNEL])
+// nc = (x1 - x2) / dist, eq. (9); d the state's displacements (of the channels that are on)
+inline void tangential_load(const ContactState &c, const Displacements &d, const V3 &nc,
+                            double dist, double r1, double r2, double R, const Tangential &K,
+                            ChannelLoad load[NCHANNEL])
 {
   const V3 zero = {0.0, 0.0, 0.0};
   if (!(K.sliding && K.rolling && K.twisting))
     for (int ch = 0; ch < NCHANNEL; ch++) load[ch] = {0.0, zero, zero, zero};
 
   if (K.sliding) {
-    const V3 zeta0 = sliding_zeta0(c, nc, r1, r2);
-    const V3 zeta = tangential_part(zeta0, nc);
+    const V3 &zeta0 = d.zeta0;
+    const V3 &zeta = d.zeta;
     ChannelLoad &s = load[SLIDE];
     s.U = 0.5 * K.k_s * dot(zeta, zeta);                                 // eq. (11)
     s.F1 = (-K.k_s * (r1 + r2 - dot(zeta0, nc)) / dist) * zeta;          // eq. (14)
@@ -148,7 +166,7 @@ inline void tangential_load(const ContactState &c, const V3 &nc, double dist, do
     s.M2 = (r2 * K.k_s) * cross(c.n2, zeta);                             // (17), 1 <-> 2, zeta -> -zeta
   }
   if (K.rolling) {
-    const V3 xi = rolling_xi(c, R);
+    const V3 &xi = d.xi;
     ChannelLoad &r = load[ROLL];
     r.U = 0.5 * K.k_r * dot(xi, xi);                                     // eq. (21)
     r.F1 = zero;
@@ -162,6 +180,12 @@ inline void tangential_load(const ContactState &c, const V3 &nc, double dist, do
     t.M1 = (-K.k_t * c.phi) * nc;                                        // eq. (27)
     t.M2 = -t.M1;
   }
+}
+
+inline void tangential_load(const ContactState &c, const V3 &nc, double dist, double r1, double r2,
+                            double R, const Tangential &K, ChannelLoad load[NCHANNEL])
+{
+  tangential_load(c, displacements(c, nc, r1, r2, R), nc, dist, r1, r2, R, K, load);
 }
 
 // work done on the particles by a channel's load over a step in which
@@ -203,13 +227,15 @@ inline V3 corrected_pointer(const V3 &n, const V3 &shift)
 }
 
 // bring the displacements back to their elastic limits; returns a bit per
-// channel that was clamped
+// channel that was clamped, and the displacements of the state it leaves in d
 inline int clamp_to_elastic_limits(ContactState &c, const V3 &nc, double r1, double r2, double R,
-                                   const Tangential &K)
+                                   const Tangential &K, Displacements &d)
 {
   int clamped = 0;
   if (K.sliding) {
-    const V3 zeta = tangential_part(sliding_zeta0(c, nc, r1, r2), nc);
+    d.zeta0 = sliding_zeta0(c, nc, r1, r2);
+    d.zeta = tangential_part(d.zeta0, nc);
+    const V3 &zeta = d.zeta;
     const double z2 = dot(zeta, zeta);
     if (z2 > K.zeta_crit * K.zeta_crit) {
       const double z = std::sqrt(z2);
@@ -220,7 +246,8 @@ inline int clamp_to_elastic_limits(ContactState &c, const V3 &nc, double r1, dou
     }
   }
   if (K.rolling) {
-    const V3 xi = rolling_xi(c, R);
+    d.xi = rolling_xi(c, R);
+    const V3 &xi = d.xi;
     const double x2 = dot(xi, xi);
     if (x2 > K.xi_crit * K.xi_crit) {
       const double x = std::sqrt(x2);
@@ -234,7 +261,15 @@ inline int clamp_to_elastic_limits(ContactState &c, const V3 &nc, double r1, dou
     c.phi = std::copysign(K.phi_crit, c.phi);
     clamped |= 1 << TWIST;
   }
+  if (clamped & ((1 << SLIDE) | (1 << ROLL))) d = displacements(c, nc, r1, r2, R);    // moved
   return clamped;
+}
+
+inline int clamp_to_elastic_limits(ContactState &c, const V3 &nc, double r1, double r2, double R,
+                                   const Tangential &K)
+{
+  Displacements d;
+  return clamp_to_elastic_limits(c, nc, r1, r2, R, K, d);
 }
 
 /* ---------------------------------------------------------------------

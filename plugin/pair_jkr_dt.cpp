@@ -371,10 +371,11 @@ void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, A
       JKRDT::ContactMotion m;
       m.d12 = d12;
       m.r = r;
+      m.rinv = 1.0 / r;
       m.v12 = JKRDT::vec(v + 3 * p) - JKRDT::vec(v + 3 * q);
       m.w1 = JKRDT::vec(omega + 3 * p);
       m.w2 = JKRDT::vec(omega + 3 * q);
-      m.vn = JKRDT::dot(m.v12, d12) / r;    // at the half step, > 0 when separating
+      m.vn = JKRDT::dot(m.v12, d12) * m.rinv;    // at the half step, > 0 when separating
 
       // a step must resolve the contact: name a pair too fast for the list
       const double step = std::fabs(m.vn) * dt;

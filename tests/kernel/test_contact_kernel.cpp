@@ -57,6 +57,7 @@ static ContactMotion at_rest(double delta)
 {
   ContactMotion m;
   m.r = 2.0 * R_GRAIN - delta;
+  m.rinv = 1.0 / m.r;
   m.d12 = {m.r, 0.0, 0.0};
   m.v12 = m.w1 = m.w2 = {0.0, 0.0, 0.0};
   m.vn = 0.0;
