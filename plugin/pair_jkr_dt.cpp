@@ -130,6 +130,16 @@ void PairJKRDT::init_style()
   check_integrator();
   check_data_file_contacts();
   find_contact_time();
+  one_radius_per_type = true;
+  type_constants.assign(param.size(), JKRDT::ContactConstants{});
+  for (int i = 1; i <= atom->ntypes; i++)
+    for (int j = 1; j <= atom->ntypes; j++) {
+      const bool present = std::isfinite(minrad[i]) && std::isfinite(minrad[j]);
+      if (present && (minrad[i] != maxrad[i] || minrad[j] != maxrad[j]))
+        one_radius_per_type = false;
+      if (present)
+        type_constants[i * nstride + j] = JKRDT::contact_constants(par(i, j), minrad[i], minrad[j]);
+    }
 
   neighbor->add_request(this, NeighConst::REQ_NEWTON_OFF);
 
@@ -325,10 +335,13 @@ void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, A
   const int *numneigh = list->numneigh;
   int **firstneigh = list->firstneigh;
 
-  // the constants depend on the type pair and the radii only: reuse the last ones
-  JKRDT::ContactConstants K{};
+  // the constants depend on the type pair and the radii only: one per type pair when
+  // each type has one radius, else the last ones reused
+  JKRDT::ContactConstants cached{};
+  const JKRDT::ContactConstants *Kp = &cached;
   const Param *last_param = nullptr;
   double last_r1 = -1.0, last_r2 = -1.0;
+  const bool by_type = one_radius_per_type;
   JKRDT::ContactResult out;
   auto trouble = [&](Trouble::Kind kind, int p, int q, double a, double b) {
     acc.trouble.kind = kind;
@@ -336,7 +349,7 @@ void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, A
     acc.trouble.q = q;
     acc.trouble.a = a;
     acc.trouble.b = b;
-    acc.trouble.S = K.S;
+    acc.trouble.S = Kp->S;
   };
 
   for (int ii = ii_from; ii < ii_to; ii++) {
@@ -360,13 +373,21 @@ void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, A
       const double delta = radsum - r;    // eq. (3)
       if (!std::isfinite(delta) || r == 0.0) return trouble(Trouble::BLOW_UP, p, q, r, 0.0);
 
-      const Param &P = par(type[p], type[q]);
-      if (&P != last_param || radius[p] != last_r1 || radius[q] != last_r2) {
-        K = JKRDT::contact_constants(P, radius[p], radius[q]);
-        last_param = &P;
-        last_r1 = radius[p];
-        last_r2 = radius[q];
+      const JKRDT::ContactConstants *typed =
+          by_type ? &type_constants[type[p] * nstride + type[q]] : nullptr;
+      if (typed && typed->r1 == radius[p] && typed->r2 == radius[q]) {
+        Kp = typed;    // (a radius changed during the run, by fix adapt, takes the else)
+      } else {
+        Kp = &cached;
+        const Param &P = par(type[p], type[q]);
+        if (&P != last_param || radius[p] != last_r1 || radius[q] != last_r2) {
+          cached = JKRDT::contact_constants(P, radius[p], radius[q]);
+          last_param = &P;
+          last_r1 = radius[p];
+          last_r2 = radius[q];
+        }
       }
+      const JKRDT::ContactConstants &K = *Kp;
 
       JKRDT::ContactMotion m;
       m.d12 = d12;

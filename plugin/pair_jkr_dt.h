@@ -90,6 +90,10 @@ class PairJKRDT : public Pair {
   std::vector<double> maxrad;  // largest radius of each type
   std::vector<double> minrad;  // smallest radius of each type (t_c)
   std::vector<double> minmass; // smallest mass of each type (t_c)
+  // contact constants of each type pair when every type has one radius (the usual
+  // monodisperse scene): looked up, never recomputed, in the pair loop
+  std::vector<JKRDT::ContactConstants> type_constants;
+  bool one_radius_per_type;
   int dt_check;                // DtCheck: what a time step above DT_STABLE t_c does
   double tc_min;               // smallest t_c over the type pairs present
   int tc_types[2];             // the type pair of tc_min
