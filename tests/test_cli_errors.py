@@ -85,3 +85,16 @@ def test_contact_snapshot_without_contacts_is_read(tmp_path):
                     "c_bonds[5] c_bonds[6] c_bonds[7] c_bonds[8]\n")
     [(step, rows)] = list(iter_local(dump))
     assert step == 0 and rows.shape == (0, 8) and rows.dtype == np.float64
+
+
+def test_help_shows_defaults_and_the_campaign_spec():
+    setup = subprocess.run([JKRDT, "setup", "--help"], capture_output=True, text=True,
+                           check=True).stdout
+    for line in ("--n-tar N_TAR         grains in the target (default: 256)",
+                 "--b-off B_OFF         impact parameter B_off (default: 0.0)",
+                 "--kind {bpca,bcca}    (default: bpca)"):
+        assert line in setup, setup
+    spec = subprocess.run([JKRDT, "campaign", "--help"], capture_output=True, text=True,
+                          check=True).stdout
+    assert "n_tar, n_pro, v_col and b_off2 are required" in spec
+    assert '"settle": {"check_tc": 50' in spec

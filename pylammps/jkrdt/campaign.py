@@ -9,6 +9,10 @@ A spec (JSON) names the grid and the scene:
      "dt": 0.014, "settle": {"check_tc": 50, "window": 5, "tolerance": 0.01,
                              "cap_tc": 40000}}
 
+n_tar, n_pro, v_col and b_off2 are required; the other keys default to the values above
+(material_overrides {}, settle {} = the settle rule's defaults), and any Material field
+can be overridden in material_overrides.
+
 Each run ends when its collision has settled (``jkrdt.stopping``; "settle" may be
 left out for the defaults, or given in part), or, with ``"settle": false``, after
 ``"steps"`` steps, dumped every ``"every"`` steps. A run that fails is recorded with

@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from . import campaign as campaign_module
 from . import collision, timestep
 from .aggregates import bonds, gyration_radius
 from .campaign import BUILDERS
@@ -289,8 +290,35 @@ def summarise(args) -> int:
     return 0
 
 
+class HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """Descriptions as written; each option's default shown unless its help names one."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        if "default" not in text and shows_default(action.default) and action.option_strings:
+            text += " (default: %(default)s)"
+        return text
+
+
+def shows_default(value) -> bool:
+    """A default worth printing: not None, not False, not argparse's SUPPRESS."""
+    return not (value is None or value is False or value is argparse.SUPPRESS)
+
+
 class ArgumentParser(argparse.ArgumentParser):
-    """argparse with its errors in one line, ``jkrdt: <what> (<how to fix>)``, status 2."""
+    """argparse with its errors in one line, ``jkrdt: <what> (<how to fix>)``, status 2,
+    and the defaults in --help."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("formatter_class", HelpFormatter)
+        super().__init__(*args, **kwargs)
+
+    def add_argument(self, *args, **kwargs):
+        # argparse prints no line for an option without help: give it one with its default
+        if args and args[0].startswith("-") and not kwargs.get("help") \
+                and shows_default(kwargs.get("default")):
+            kwargs["help"] = "(default: %(default)s)"
+        return super().add_argument(*args, **kwargs)
 
     def error(self, message):
         self.exit(2, f"jkrdt: {message} (see '{self.prog} --help')\n")
@@ -353,9 +381,10 @@ def main(argv=None) -> int:
     an.add_argument("--partial", action="store_true",
                     help="analyse a run that failed or was cut off, as far as its dumps go")
     cp = sub.add_parser("campaign", help="run a grid of collisions from a JSON spec "
-                        "(resumes: finished runs are skipped)")
-    cp.add_argument("spec")
-    cp.add_argument("dir")
+                        "(resumes: finished runs are skipped)",
+                        description=campaign_module.__doc__)
+    cp.add_argument("spec", help="the campaign's JSON spec (keys above)")
+    cp.add_argument("dir", help="where the runs go, one directory each")
     cp.add_argument("--quiet", action="store_true")
     sm = sub.add_parser("summarise", help="B_off-weighted statistics of a campaign: "
                         "runs.csv, summary.csv, summary.json, plots")
