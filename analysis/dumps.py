@@ -87,6 +87,28 @@ def last_local_snapshot(path) -> np.ndarray:
     return rows
 
 
+class ContactSnapshots:
+    """The contact list of a ``dump local`` file by timestep, read forward as frames ask
+    for increasing steps (read again from the start for an earlier one)."""
+
+    def __init__(self, path):
+        self.path = Path(path)
+        self._stream, self._pending = None, None
+
+    def pairs(self, step: int) -> np.ndarray:
+        """(n_c, 2) atom IDs of the bonded contacts at ``step``."""
+        if self._stream is None or (self._pending is not None and self._pending[0] > step):
+            self._stream, self._pending = iter_local(self.path), None
+        while self._pending is None or self._pending[0] < step:
+            self._pending = next(self._stream, None)
+            if self._pending is None:
+                raise ValueError(f"{self.path} ends before step {step}")
+        if self._pending[0] != step:
+            raise ValueError(f"{self.path} has no snapshot at step {step}: write both dumps "
+                             "at the same interval")
+        return self._pending[1][:, :2].astype(np.int64)
+
+
 @dataclasses.dataclass
 class Frame:
     step: int

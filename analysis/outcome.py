@@ -10,6 +10,9 @@
 
 and the scalings of Wada et al. (2007): E_imp / (n_k E_roll) and E_imp / (n_k E_break),
 with n_k = N_total - 2 the contacts of the two aggregates before impact (sec. 4).
+
+``CollisionOutcome`` computes the per-frame measures the MDAnalysis way, as an
+``AnalysisBase`` over a Universe of a run's atom dump.
 """
 
 from __future__ import annotations
@@ -17,6 +20,7 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
+from MDAnalysis.analysis.base import AnalysisBase
 
 from jkrdt.aggregates import gyration_radius
 
@@ -76,3 +80,58 @@ def energy_scalings(e_imp: float, n_k: int, e_roll: float | None, e_break: float
     """E_imp in units of n_k E_roll and of n_k E_break (Wada et al. 2007, Table 1)."""
     return dict(E_imp_over_nk_Eroll=None if e_roll is None else e_imp / (n_k * e_roll),
                 E_imp_over_nk_Ebreak=e_imp / (n_k * e_break))
+
+
+class CollisionOutcome(AnalysisBase):
+    """Per-frame outcome of an aggregate collision over a Universe of its atom dump
+    (``analysis.dumps.atoms_universe``: positions plus the per-atom ``radius`` column).
+
+    Fragments come from ``contacts``, the run's contact dump (compute jkr/dt/contacts
+    through ``dump local``, joined by timestep), or, without one, from positions within
+    r_i + r_j + ``tolerance``. ``run(start, stop, step)`` as for any AnalysisBase; then
+    ``results`` holds one entry per analysed frame in ``step``, ``n_largest``,
+    ``n_second``, ``n_fragments``, ``growth_efficiency``, ``gyration_radius_largest``
+    and ``contacts_per_particle`` (arrays), and for the last frame analysed
+    ``fragment_sizes`` and ``N_cum`` (grains in fragments of at most N grains)."""
+
+    MEASURES = [f.name for f in dataclasses.fields(Outcome)]
+
+    def __init__(self, universe, n_target: int, n_projectile: int, contacts=None,
+                 tolerance: float | None = None, **kwargs):
+        super().__init__(universe.trajectory, **kwargs)
+        self._atoms = universe.atoms
+        self._order = np.argsort(self._atoms.ids)
+        self._ids = self._atoms.ids[self._order]
+        from .dumps import ContactSnapshots
+        self._contacts = ContactSnapshots(contacts) if contacts is not None else None
+        self._n = (n_target, n_projectile)
+        self._tolerance = tolerance
+        if self._contacts is None and tolerance is None:
+            raise ValueError("no contact dump given: give the position tolerance (delta_c "
+                             "of the material)")
+
+    def _prepare(self):
+        for name in self.MEASURES:
+            self.results[name] = []
+        self._labels = None
+
+    def _single_frame(self):
+        from .dumps import Frame
+        ts = self._ts
+        if "radius" not in ts.data:
+            raise ValueError("the atom dump has no radius column; dump 'id type radius x y z'")
+        step = int(ts.data["step"])
+        frame = Frame(step=step, ids=self._ids,
+                      x=self._atoms.positions[self._order].astype(np.float64),
+                      radius=np.asarray(ts.data["radius"][self._order], dtype=np.float64),
+                      pairs=self._contacts.pairs(step) if self._contacts else None)
+        self._labels, outcome = measure_frame(frame, *self._n, self._tolerance)
+        for name in self.MEASURES:
+            self.results[name].append(getattr(outcome, name))
+
+    def _conclude(self):
+        for name in self.MEASURES:
+            self.results[name] = np.asarray(self.results[name])
+        if self._labels is not None:
+            sizes, cumulative = frag.cumulative_number(self._labels)
+            self.results.fragment_sizes, self.results.N_cum = sizes, cumulative

@@ -120,3 +120,28 @@ def test_analyse_command(run):
     assert f"largest remnant N_lar       {out['n_largest']}" in done.stdout
     for name in ("outcome.png", "outcome.pdf", "energy.png", "energy.pdf"):
         assert (d / name).stat().st_size > 0
+
+
+def test_collision_outcome_is_an_mdanalysis_analysis(run):
+    # the per-frame measures as an AnalysisBase over the run's own Universe: sliced runs
+    # give the full run's figures at their frames, and the last frame's N_cum
+    from jkrdt.analysis.dumps import atoms_universe
+    from jkrdt.analysis.outcome import CollisionOutcome
+    d, *_ = run
+    rows = read_csv(d / "frames.csv")
+    u = atoms_universe(d / "atoms.dump")
+    full = CollisionOutcome(u, N, N, contacts=d / "contacts.dump").run()
+    assert list(full.results.step) == list(range(0, 12001, 1000))
+    for name in ("n_largest", "n_fragments", "contacts_per_particle", "growth_efficiency"):
+        assert np.allclose(full.results[name], [float(r[name]) for r in rows]), name
+    sliced = CollisionOutcome(u, N, N, contacts=d / "contacts.dump").run(start=2, stop=11,
+                                                                         step=3)
+    assert list(sliced.results.step) == [2000, 5000, 8000]
+    assert np.array_equal(sliced.results.n_largest, full.results.n_largest[2:11:3])
+    backwards_again = CollisionOutcome(u, N, N, contacts=d / "contacts.dump").run(stop=3)
+    assert list(backwards_again.results.step) == [0, 1000, 2000]
+    # without the contact dump: fragments from positions within delta_c, the same at the end
+    by_positions = CollisionOutcome(u, N, N, tolerance=S.delta_c).run(start=12)
+    outcome = json.loads((d / "outcome.json").read_text())
+    assert by_positions.results.n_largest[-1] == outcome["n_largest"]
+    assert list(full.results.N_cum) == outcome["N_cum"]
