@@ -91,8 +91,11 @@ class CollisionOutcome(AnalysisBase):
     r_i + r_j + ``tolerance``. ``run(start, stop, step)`` as for any AnalysisBase; then
     ``results`` holds one entry per analysed frame in ``step``, ``n_largest``,
     ``n_second``, ``n_fragments``, ``growth_efficiency``, ``gyration_radius_largest``
-    and ``contacts_per_particle`` (arrays), and for the last frame analysed
-    ``fragment_sizes`` and ``N_cum`` (grains in fragments of at most N grains)."""
+    and ``contacts_per_particle`` (arrays), and for the last frame analysed its
+    ``labels`` (fragment of each atom, by ascending ID), ``positions``, ``has_contacts``,
+    ``fragment_sizes`` and ``N_cum`` (grains in fragments of at most N grains). A contact
+    snapshot cut off by the end of its file (a run killed while dumping) ends the
+    analysis at the frame before it; ``results.cut_off_at`` is then that frame's step."""
 
     MEASURES = [f.name for f in dataclasses.fields(Outcome)]
 
@@ -113,25 +116,37 @@ class CollisionOutcome(AnalysisBase):
     def _prepare(self):
         for name in self.MEASURES:
             self.results[name] = []
-        self._labels = None
+        self.results.cut_off_at = None
+        self._last = None
 
     def _single_frame(self):
-        from .dumps import Frame
+        from .dumps import Frame, TruncatedDump
         ts = self._ts
+        if self.results.cut_off_at is not None:
+            return
         if "radius" not in ts.data:
             raise ValueError("the atom dump has no radius column; dump 'id type radius x y z'")
         step = int(ts.data["step"])
+        try:
+            pairs = self._contacts.pairs(step) if self._contacts else None
+        except TruncatedDump:
+            self.results.cut_off_at = step
+            return
         frame = Frame(step=step, ids=self._ids,
                       x=self._atoms.positions[self._order].astype(np.float64),
                       radius=np.asarray(ts.data["radius"][self._order], dtype=np.float64),
-                      pairs=self._contacts.pairs(step) if self._contacts else None)
-        self._labels, outcome = measure_frame(frame, *self._n, self._tolerance)
+                      pairs=pairs)
+        labels, outcome = measure_frame(frame, *self._n, self._tolerance)
         for name in self.MEASURES:
             self.results[name].append(getattr(outcome, name))
+        self._last = frame, labels
 
     def _conclude(self):
         for name in self.MEASURES:
             self.results[name] = np.asarray(self.results[name])
-        if self._labels is not None:
-            sizes, cumulative = frag.cumulative_number(self._labels)
+        if self._last is not None:
+            frame, labels = self._last
+            sizes, cumulative = frag.cumulative_number(labels)
+            self.results.labels, self.results.positions = labels, frame.x
+            self.results.has_contacts = frame.pairs is not None
             self.results.fragment_sizes, self.results.N_cum = sizes, cumulative

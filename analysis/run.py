@@ -1,5 +1,8 @@
-"""Analysis of one run directory (written by ``jkrdt setup`` + ``jkrdt run``, the deck
-``inputs/collision.lmp``, or ``jkrdt.session.Session``):
+"""Analysis of one run directory, written by ``jkrdt setup`` + ``jkrdt run``, the deck
+``inputs/collision.lmp``, or ``jkrdt.session.Session``. It composes the reading
+(analysis.dumps), the per-frame measures (analysis.outcome.CollisionOutcome, an
+MDAnalysis AnalysisBase), the energy ledger (analysis.thermo) and the writers
+(analysis.tables, analysis.plots):
 
     collision.json, log.lammps, atoms.dump, contacts.dump   ->
     frames.csv     the outcome metrics and the energy partition at every dumped frame
@@ -17,9 +20,8 @@ import numpy as np
 from jkrdt.materials import from_dict, scales
 from jkrdt.stopping import ENERGY_WARN, STOP_WORDS
 
-from . import fragments as frag
-from .dumps import frames
-from .outcome import energy_scalings, measure_frame
+from .dumps import atoms_universe
+from .outcome import CollisionOutcome, energy_scalings
 from .plots import energy_partition, snapshot
 from .status import run_status
 from .tables import write_csv, write_json
@@ -52,43 +54,46 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
     if (run / "log.lammps").exists():
         thermo = read_thermo(run / "log.lammps")
         budget = energy_budget(thermo)
-    rows, last = [], None
-    for frame in frames(run):
-        labels, result = measure_frame(frame, n_tar, n_pro, tolerance)
-        row = dict(result.__dict__)
+    contacts = run / "contacts.dump"
+    measured = CollisionOutcome(atoms_universe(run / "atoms.dump"), n_tar, n_pro,
+                                contacts=contacts if contacts.exists() else None,
+                                tolerance=tolerance).run().results
+    rows = [{name: measured[name][k].item() for name in CollisionOutcome.MEASURES}
+            for k in range(len(measured.step))]
+    for row in rows:
         if budget is not None:
-            at = np.flatnonzero(thermo["Step"] == frame.step)
+            at = np.flatnonzero(thermo["Step"] == row["step"])
             if at.size:
                 row["time"] = float(thermo["Time"][at[0]])
                 row.update({name: float(budget[name][at[0]]) for name in
                             ["kinetic", "potential", "dissipated", *CHANNELS]})
-        rows.append(row)
-        last = frame, labels, result
-    if last is None:
+    if not rows:
         raise ValueError(f"{run / 'atoms.dump'} has no frames"
                          + (f" ({status.problem})" if status.problem else ""))
-    frame, labels, final = last
-    status = run_status(run, last_dump_step=frame.step)
+    last_step = rows[-1]["step"]
+    final = {name: rows[-1][name] for name in CollisionOutcome.MEASURES}
+    labels, x_last = measured.labels, measured.positions
+    status = run_status(run, last_dump_step=last_step)
     if status.problem and not partial:
         raise RunNotComplete(f"{run}: {status.problem}; analyse what is there with --partial")
     n_k = n_tar + n_pro - 2
-    sizes, cumulative = frag.cumulative_number(labels)
+    sizes, cumulative = measured.fragment_sizes, measured.N_cum
     out = dict(run=str(run), N_tar=n_tar, N_pro=n_pro, v_col=meta["v_col"],
                B_off=meta["B_off"], seed=meta.get("seed"), model=meta.get("model"),
                kind=meta.get("kind"), dimension=meta["dimension"],
                material=mat.name, xi_crit=mat.xi_crit, tvis=mat.tvis, radius=meta["radius"],
                E_imp=meta["E_imp"], n_k=n_k, E_roll=s.E_roll, E_break=s.E_break,
                **energy_scalings(meta["E_imp"], n_k, s.E_roll, s.E_break),
-               **final.__dict__, fragment_sizes=sizes.tolist(), N_cum=cumulative.tolist(),
-               contacts_source="contact list" if frame.pairs is not None else
+               **final, fragment_sizes=sizes.tolist(), N_cum=cumulative.tolist(),
+               contacts_source="contact list" if measured.has_contacts else
                f"positions, r_i + r_j + {tolerance:.3e} m")
     out.update(stop_reason=status.stop_reason, stop_step=status.stop_step,
-               last_step=frame.step, settled=status.stop_reason == "settled",
+               last_step=last_step, settled=status.stop_reason == "settled",
                problem=status.problem)
     if budget is not None:
         e_imp = meta["E_imp"]
-        upto = thermo["Step"] <= frame.step
-        at = np.flatnonzero(thermo["Step"] == frame.step)
+        upto = thermo["Step"] <= last_step
+        at = np.flatnonzero(thermo["Step"] == last_step)
         left = budget["kinetic"][at[0]] if at.size else budget["kinetic"][upto][-1]
         error = energy_error(budget, e_imp)
         t_end = float(thermo["Time"][at[0]] if at.size else thermo["Time"][upto][-1])
@@ -102,11 +107,11 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
     if plots:
         title = (f"{mat.name} {(meta.get('kind') or '').upper()} {n_tar}+{n_pro}, "
                  f"v = {meta['v_col']:g} m/s, B_off = {meta['B_off']:g}, {meta.get('model', '')}")
-        when = f"{status.stop_reason} at step {frame.step}"
+        when = f"{status.stop_reason} at step {last_step}"
         if "time_end" in out:
             when += (f", t = {out['time_end'] * 1e9:.0f} ns = {out['time_end_over_tc']:.0f} t_c; "
                      f"max |dE|/E_imp = {out['energy_error']:.1e}")
-        out["pictures"] = [str(p) for p in snapshot(run / "outcome", frame.x, labels,
+        out["pictures"] = [str(p) for p in snapshot(run / "outcome", x_last, labels,
                                                     f"{title}\n{when}", radius=meta["radius"])]
         if budget is not None:
             out["pictures"] += [str(p) for p in energy_partition(run / "energy", thermo["Time"],
