@@ -128,24 +128,13 @@ def frames(run, atoms="atoms.dump", contacts="contacts.dump") -> Iterator[Frame]
     u = atoms_universe(run / atoms)
     order = np.argsort(u.atoms.ids)
     ids = u.atoms.ids[order]
-    local = iter_local(run / contacts) if (run / contacts).exists() else None
-    pending = None
+    local = ContactSnapshots(run / contacts) if (run / contacts).exists() else None
     for ts in u.trajectory:
         step = int(ts.data["step"])
-        pairs = None
-        if local is not None:
-            # both dumps are written every N steps; skip contact snapshots the atoms lack
-            while pending is None or pending[0] < step:
-                try:
-                    pending = next(local, None)
-                except TruncatedDump:
-                    return                       # the frames end with the last whole snapshot
-                if pending is None:
-                    raise ValueError(f"{run / contacts} ends before step {step} of {atoms}")
-            if pending[0] != step:
-                raise ValueError(f"{run / contacts} has no snapshot at step {step}: write "
-                                 "both dumps at the same interval")
-            pairs = pending[1][:, :2].astype(np.int64)
+        try:
+            pairs = local.pairs(step) if local is not None else None
+        except TruncatedDump:
+            return                       # the frames end with the last whole snapshot
         if "radius" not in ts.data:
             raise ValueError(f"{run / atoms}: no radius column; dump 'id type radius x y z'")
         yield Frame(step=step, ids=ids, x=ts.positions[order].astype(np.float64),

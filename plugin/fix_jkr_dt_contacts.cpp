@@ -27,7 +27,7 @@ static constexpr int INITIAL_CAPACITY = 4;    // BPCA grains hold ~2 contacts; r
 FixJKRDTContacts::FixJKRDTContacts(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), npartner(nullptr), partner(nullptr), values(nullptr), ledger(nullptr),
     owner(nullptr), dnum(0), bonded(nullptr), slot_values(nullptr), slot_first(nullptr),
-    natoms_at_run_end(0), mask(0), maxpartner(INITIAL_CAPACITY), nmax_alloc(0), nslot(0),
+    natoms_at_run_end(0), mask(0), maxpartner(INITIAL_CAPACITY), nmax_alloc(0),
     maxslot(0), slot_dnum(0), maxfirst(0), slot_list(nullptr), slot_build(-1), rows_stale(false)
 {
   if (narg != 4)
@@ -84,9 +84,10 @@ void FixJKRDTContacts::check_atoms(bigint natoms_before)
   int moved = 0;
   for (int i = 0; i < nlocal; i++)
     if (npartner[i] > 0 && owner[i] != tag[i]) moved++;
+  // atoms renumbered, and whether atoms were deleted, over all ranks
   int changed[2] = {moved, natoms_before > 0 && atom->natoms < natoms_before};
   int any[2] = {0, 0};
-  MPI_Allreduce(changed, any, 2, MPI_INT, MPI_MAX, world);
+  MPI_Allreduce(changed, any, 2, MPI_INT, MPI_SUM, world);
   if (!any[0] && !any[1]) return;
 
   std::vector<tagint> mine;
@@ -101,16 +102,15 @@ void FixJKRDTContacts::check_atoms(bigint natoms_before)
   std::sort(renamed.begin(), renamed.end());
 
   const int off_n = has_field(POINTERS) ? offset(POINTERS) : -1;
-  bigint counts[2] = {0, 0}, all[2] = {0, 0};    // contacts removed, atoms renamed
+  bigint removed = 0, all_removed = 0;
   for (int i = 0; i < nlocal; i++) {
-    if (npartner[i] > 0 && owner[i] != tag[i]) counts[1]++;
     for (int k = npartner[i] - 1; k >= 0; k--) {
       const tagint was = partner[i][k];
       auto it = std::lower_bound(renamed.begin(), renamed.end(),
                                  std::make_pair(was, std::numeric_limits<tagint>::min()));
       if (it == renamed.end() || it->first != was) {    // the partner is gone
         remove(i, k);
-        counts[0]++;
+        removed++;
         continue;
       }
       const tagint now = it->second;
@@ -122,17 +122,18 @@ void FixJKRDTContacts::check_atoms(bigint natoms_before)
     }
     owner[i] = tag[i];
   }
-  MPI_Allreduce(counts, all, 2, MPI_LMP_BIGINT, MPI_SUM, world);
-  if (all[0] && !any[1])
+  MPI_Allreduce(&removed, &all_removed, 1, MPI_LMP_BIGINT, MPI_SUM, world);
+  if (all_removed && !any[1])
     error->all(FLERR,
                "pair jkr/dt: {} stored contacts point at atoms that no longer store them, "
                "though no atom was deleted: the contact state is inconsistent",
-               all[0]);
+               all_removed);
   if (comm->me == 0) {
-    if (all[0]) utils::logmesg(lmp, "pair jkr/dt: {} contacts with deleted atoms removed\n", all[0]);
-    if (all[1])
+    if (all_removed)
+      utils::logmesg(lmp, "pair jkr/dt: {} contacts with deleted atoms removed\n", all_removed);
+    if (any[0])
       utils::logmesg(lmp, "pair jkr/dt: the contacts of {} renumbered atoms follow their new IDs\n",
-                     all[1]);
+                     any[0]);
   }
 }
 
@@ -287,7 +288,6 @@ void FixJKRDTContacts::to_slots(NeighList *list)
     memory->create(bonded, maxslot, "jkr/dt:bonded");
     if (dnum) memory->create(slot_values, (bigint) maxslot * dnum, "jkr/dt:slot_values");
   }
-  nslot = n;
 
   std::vector<int> found(nlocal, 0);
   bool one_sided = false;
@@ -481,8 +481,7 @@ int FixJKRDTContacts::unpack_exchange(int nlocal, double *buf)
 
 int FixJKRDTContacts::pack_restart(int i, double *buf)
 {
-  to_rows();
-  int m = 1;
+  int m = 1;    // pack_exchange below writes the rows back first
   buf[m++] = mask;
   m += pack_exchange(i, &buf[m]);
   buf[0] = m;

@@ -139,7 +139,7 @@ class FixJKRDTContacts : public Fix {
   int nmax_alloc;       // rows allocated in the per-atom arrays
 
   void grow_partner_capacity(int needed);
-  int nslot, maxslot, slot_dnum;    // slots in use, allocated, values per allocated slot
+  int maxslot, slot_dnum;           // slots allocated, values per allocated slot
   int maxfirst;                     // ilist entries allocated
   const class NeighList *slot_list; // the list the slots follow ...
   bigint slot_build;                // ... as built at this step (neighbor->lastcall)

@@ -265,13 +265,6 @@ inline int clamp_to_elastic_limits(ContactState &c, const V3 &nc, double r1, dou
   return clamped;
 }
 
-inline int clamp_to_elastic_limits(ContactState &c, const V3 &nc, double r1, double r2, double R,
-                                   const Tangential &K)
-{
-  Displacements d;
-  return clamp_to_elastic_limits(c, nc, r1, r2, R, K, d);
-}
-
 /* ---------------------------------------------------------------------
    energy dissipated in a step, eqs. (39)-(41) made exact for the scheme
 

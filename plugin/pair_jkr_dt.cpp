@@ -277,7 +277,7 @@ void PairJKRDT::compute(int eflag, int vflag)
       }
   }
 
-  Accumulator total = acc[0];
+  Accumulator &total = acc[0];    // the other threads' sums go into thread 0's
   for (int t = 0; t < nthreads; t++) {
     if (acc[t].trouble.kind != Trouble::NONE) report(acc[t].trouble);
     if (t == 0) continue;

@@ -351,9 +351,8 @@ void PairJKRDT::warn_data_file() const
   if (contacts_at_run_end > 0)
     error->warning(FLERR,
                    "pair jkr/dt: write_data does not carry the {} bonded contacts (pointers, "
-                   "twist, damping force, energy ledger); a run that takes its pair coefficients "
-                   "from this file refuses to start. To continue a run, use write_restart / "
-                   "read_restart",
+                   "twist, damping force, energy ledger); a run read from this file refuses to "
+                   "start. To continue a run, use write_restart / read_restart",
                    contacts_at_run_end);
 }
 
