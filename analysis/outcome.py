@@ -93,7 +93,9 @@ class CollisionOutcome(AnalysisBase):
     ``n_second``, ``n_fragments``, ``growth_efficiency``, ``gyration_radius_largest``
     and ``contacts_per_particle`` (arrays), and for the last frame analysed its
     ``labels`` (fragment of each atom, by ascending ID), ``positions``, ``has_contacts``,
-    ``fragment_sizes`` and ``N_cum`` (grains in fragments of at most N grains). A contact
+    ``fragment_sizes`` and ``N_cum`` (grains in fragments of at most N grains), with the
+    atoms' ``types`` (1 target, 2 projectile) and the first analysed frame's
+    ``first_positions``. A contact
     snapshot cut off by the end of its file (a run killed while dumping) ends the
     analysis at the frame before it; ``results.cut_off_at`` is then that frame's step."""
 
@@ -117,6 +119,7 @@ class CollisionOutcome(AnalysisBase):
         for name in self.MEASURES:
             self.results[name] = []
         self.results.cut_off_at = None
+        self.results.types = self._atoms.types[self._order].astype(int)
         self._last = None
 
     def _single_frame(self):
@@ -139,6 +142,8 @@ class CollisionOutcome(AnalysisBase):
         labels, outcome = measure_frame(frame, *self._n, self._tolerance)
         for name in self.MEASURES:
             self.results[name].append(getattr(outcome, name))
+        if self._last is None:
+            self.results.first_positions = frame.x
         self._last = frame, labels
 
     def _conclude(self):

@@ -1,6 +1,8 @@
 """Pictures of collision outcomes and campaigns (matplotlib, each as PNG and PDF).
 
-snapshot            grains of one outcome, coloured by fragment
+outcome             the collision's first and last frame: target and projectile, the impact
+                    direction and offset, the largest fragments
+timeline            N_lar, fragments, n_con and the energy shares against time
 energy_partition    kinetic, potential and dissipated energy by channel against time
                     (Wada et al. 2007, Fig. 6)
 compression         r_g / (r_1 N_lar^1/2) and n_con against E_imp / (n_k E_roll), with
@@ -34,37 +36,168 @@ def _save(fig, path) -> list[Path]:
     return out
 
 
-def snapshot(path, x: np.ndarray, labels: np.ndarray, title: str = "",
-             radius: float | None = None) -> list[Path]:
-    """Projections x-y and x-z of the grains, drawn to scale when ``radius`` is given:
-    the largest fragment blue, the next nine in their own colours, the rest grey."""
+#: colours of the largest fragments, largest first; smaller fragments are drawn faint grey
+FRAGMENT_COLOURS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e"]
+#: colours of the two bodies at the start, target and projectile
+BODY_COLOURS = {1: "#4c72b0", 2: "#dd8452"}
+
+
+#: the smallest drawn grain, as a fraction of the view: fragments spread far apart stay visible
+MIN_DISC = 1.0 / 150
+
+
+def _discs(ax, x, i, j, diameter, colours, alpha=1.0, zorder=1):
+    """Grains as circles of ``diameter`` (micron) in the (i, j) projection, in micron."""
+    from matplotlib.collections import EllipseCollection
+
+    um = x * 1e6
+    d = np.full(len(x), diameter)
+    ax.add_collection(EllipseCollection(d, d, np.zeros(len(x)), units="xy",
+                                        offsets=um[:, [i, j]], offset_transform=ax.transData,
+                                        facecolors=colours, edgecolors="k", linewidths=0.3,
+                                        alpha=alpha, zorder=zorder))
+
+
+def _frame_axes(ax, x, i, j, radius, names) -> float:
+    """Limits around the grains, equal aspect; returns the diameter to draw them with
+    (micron): their own, or MIN_DISC of the view when they spread much farther."""
+    um = x * 1e6
+    span = max(np.ptp(um[:, i]), np.ptp(um[:, j]))
+    diameter = max(2 * radius * 1e6, MIN_DISC * span)
+    pad = 0.75 * diameter
+    ax.set_xlim(um[:, i].min() - pad, um[:, i].max() + pad)
+    ax.set_ylim(um[:, j].min() - pad, um[:, j].max() + pad)
+    ax.set_aspect("equal")
+    ax.set_xlabel(f"{names[i]} (micron)")
+    ax.set_ylabel(f"{names[j]} (micron)")
+    if diameter > 2 * radius * 1e6:
+        ax.text(0.01, 0.01, f"grains drawn {diameter / (2 * radius * 1e6):.0f}x enlarged",
+                transform=ax.transAxes, fontsize=7, color="0.4")
+    return diameter
+
+
+def _when(step, time, t_c) -> str:
+    return f"step {step}: t = {time * 1e9:.3g} ns = {time / t_c:.0f} t_c"
+
+
+def outcome(path, start: np.ndarray, end: np.ndarray, body: np.ndarray, labels: np.ndarray,
+            radius: float, dim: int, when: tuple, t_c: float, b: float | None = None,
+            title: str = "") -> list[Path]:
+    """The collision at its first and last frame (columns), in x-y and, in 3D, x-z
+    (rows), grains to scale. At the start the target and the projectile have their own
+    colours, with the impact direction (the projectile moves along -x) and the offset b
+    drawn; at the end the five largest fragments have their own colours (grains from the
+    projectile in a lighter shade of it) and the others are faint.
+    ``when`` = ((step, time in s) of the start, (step, time) of the end)."""
     plt = _pyplot()
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    views = [(0, 1)] if dim == 2 else [(0, 1), (0, 2)]
+    fig, axes = plt.subplots(len(views), 2, figsize=(13, 4.6 * len(views)), squeeze=False,
+                             constrained_layout=True)
+    names = "xyz"
     sizes = np.bincount(labels)
     rank = np.empty_like(sizes)
-    rank[np.argsort(sizes)[::-1]] = np.arange(len(sizes))
-    colour = np.minimum(rank[labels], 10)
-    fig, axes = plt.subplots(1, 2, figsize=(10, 5), constrained_layout=True)
-    order = np.argsort(colour, kind="stable")      # the largest first, fragments on top
-    um = (x[order] - x.mean(axis=0)) * 1e6
-    dots = []
-    for ax, (i, j, name) in zip(axes, [(0, 1, "y"), (0, 2, "z")]):
-        dots.append(ax.scatter(um[:, i], um[:, j], c=colour[order], cmap="tab10", s=4, vmin=0,
-                               vmax=10, edgecolors="k", linewidths=0.2))
-        ax.set_xlabel("x (micron)")
-        ax.set_ylabel(f"{name} (micron)")
-        ax.set_aspect("equal")
-    fig.suptitle(title + f"\n{len(sizes)} fragments; largest {sizes.max()} grains (blue)")
-    if radius:
-        fig.canvas.draw()                      # final axes sizes, then grains at their size
-        for ax, dot in zip(axes, dots):
-            points_per_um = ax.get_window_extent().width * 72 / fig.dpi / np.ptp(ax.get_xlim())
-            dot.set_sizes([(2 * radius * 1e6 * points_per_um) ** 2])
+    rank[np.argsort(sizes, kind="stable")[::-1]] = np.arange(len(sizes))
+    grain_rank = rank[labels]
+    big = grain_rank < len(FRAGMENT_COLOURS)
+    from matplotlib.colors import to_rgb
+
+    def shade(r, k):           # the fragment's colour; lighter for grains of the projectile
+        rgb = np.array(to_rgb(FRAGMENT_COLOURS[r] if r < len(FRAGMENT_COLOURS) else "0.7"))
+        return tuple(rgb + 0.5 * (1 - rgb)) if k == 2 else tuple(rgb)
+    colours = np.array([shade(r, k) for r, k in zip(grain_rank, body)])
+    start = start - start.mean(axis=0)
+    end = end - end.mean(axis=0)
+    tar, pro = body == 1, body == 2
+    for row, (i, j) in enumerate(views):
+        a, e = axes[row]
+        d = _frame_axes(a, start, i, j, radius, names)
+        _discs(a, start, i, j, d, [BODY_COLOURS[k] for k in body])
+        if j == 1:                      # the impact direction and the offset, in x-y
+            c_tar, c_pro = start[tar].mean(axis=0) * 1e6, start[pro].mean(axis=0) * 1e6
+            span = np.ptp(start[:, 0]) * 1e6
+            a.annotate("", xy=(c_pro[0] - 0.3 * span, c_pro[1]), xytext=(c_pro[0], c_pro[1]),
+                       arrowprops=dict(arrowstyle="-|>", lw=2, color="k"), zorder=5)
+            for c in (c_tar, c_pro):
+                a.axhline(c[1], color="k", ls=":", lw=0.8, zorder=4)
+            if b is not None and b > 0:
+                x_b = a.get_xlim()[0] + 0.05 * np.ptp(a.get_xlim())
+                a.annotate("", xy=(x_b, c_tar[1]), xytext=(x_b, c_pro[1]),
+                           arrowprops=dict(arrowstyle="<->", lw=1), zorder=5)
+                a.text(x_b, 0.5 * (c_tar[1] + c_pro[1]), f" b = {b * 1e6:.2f} micron",
+                       va="center", fontsize=8, zorder=6,
+                       bbox=dict(facecolor="w", edgecolor="none", alpha=0.8, pad=1))
+        d = _frame_axes(e, end, i, j, radius, names)
+        _discs(e, end[~big], i, j, d, colours[~big], alpha=0.35)
+        _discs(e, end[big], i, j, d, colours[big], zorder=2)
+    axes[0, 0].set_title("start, " + _when(*when[0], t_c), fontsize=10)
+    axes[0, 1].set_title("end, " + _when(*when[1], t_c), fontsize=10)
+    axes[0, 0].legend(handles=[Patch(color=BODY_COLOURS[1], label=f"target ({tar.sum()})"),
+                               Patch(color=BODY_COLOURS[2], label=f"projectile ({pro.sum()})"),
+                               Line2D([], [], color="k", marker=">", label="projectile's motion")],
+                      fontsize=8, loc="upper right")
+    order = np.argsort(sizes, kind="stable")[::-1]
+    def grains(n):
+        return f"{n} grain" + ("s" if n != 1 else "")
+    handles = []
+    for k, f in enumerate(order[:len(FRAGMENT_COLOURS)]):
+        from_pro = int(np.sum((labels == f) & pro))
+        handles.append(Patch(color=FRAGMENT_COLOURS[k], label=f"{grains(sizes[f])} "
+                             f"({from_pro} from the projectile, light)"))
+    rest = order[len(FRAGMENT_COLOURS):]
+    if len(rest):
+        handles.append(Patch(color="0.75", label=f"{len(rest)} more, of at most "
+                             f"{grains(sizes[rest].max())}"))
+    axes[0, 1].legend(handles=handles, fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1),
+                      title=f"{len(sizes)} fragment(s)", title_fontsize=8)
+    fig.suptitle(title, fontsize=10)
+    return _save(fig, path)
+
+
+def timeline(path, rows: list[dict], n_total: int, e_imp: float, t_c: float,
+             title: str = "") -> list[Path]:
+    """N_lar and the second largest, the number of fragments, n_con and the energy shares
+    against time, from the per-frame rows of ``frames.csv`` (the energies and the time
+    come from the run's log; without one, against the step)."""
+    plt = _pyplot()
+    has_time = all("time" in r for r in rows)
+    x = np.array([r["time"] * 1e9 if has_time else r["step"] for r in rows], dtype=float)
+    energies = all("kinetic" in r for r in rows)
+    fig, axes = plt.subplots(4 if energies else 3, 1, figsize=(7, 9 if energies else 7),
+                             sharex=True, constrained_layout=True)
+
+    def get(name):
+        return np.array([r[name] for r in rows], dtype=float)
+
+    axes[0].plot(x, get("n_largest") / n_total, "o-", ms=3, label="N_lar / N_total")
+    axes[0].plot(x, get("n_second") / n_total, "s-", ms=3, label="second largest / N_total")
+    axes[0].set_ylim(0, 1.05)
+    axes[0].legend(fontsize=8)
+    axes[1].plot(x, get("n_fragments"), "o-", ms=3, color="C2")
+    axes[1].set_ylabel("fragments")
+    axes[2].plot(x, get("contacts_per_particle"), "o-", ms=3, color="C3")
+    axes[2].set_ylabel("n_con (largest)")
+    if energies:
+        axes[3].plot(x, get("kinetic") / e_imp, label="kinetic (with rotation)")
+        axes[3].plot(x, get("dissipated") / e_imp, label="dissipated")
+        axes[3].plot(x, (get("potential") - rows[0]["potential"]) / e_imp,
+                     label="potential - U(0)")
+        axes[3].set_ylabel("energy / E_imp")
+        axes[3].legend(fontsize=8)
+    axes[-1].set_xlabel("time (ns)" if has_time else "step")
+    if has_time:
+        top = axes[0].secondary_xaxis("top", functions=(lambda ns: ns * 1e-9 / t_c,
+                                                        lambda tc: tc * t_c * 1e9))
+        top.set_xlabel("time (t_c)")
+    fig.suptitle(title, fontsize=10)
     return _save(fig, path)
 
 
 def energy_partition(path, time: np.ndarray, budget: dict, e_imp: float, title: str = ""):
     """Energies over E_imp: kinetic, potential change, dissipation by channel, and the sum."""
-    from .thermo import CHANNELS
+    from jkrdt.ledger import CHANNELS
 
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(7, 4.5), constrained_layout=True)
@@ -82,65 +215,111 @@ def energy_partition(path, time: np.ndarray, budget: dict, e_imp: float, title: 
     return _save(fig, path)
 
 
+def _two_d_bcca(rows: list[dict]) -> bool:
+    """Whether every run is a 2D BCCA collision, the scene of Wada et al. (2007)'s fits."""
+    return all(r.get("dimension") == 2 and r.get("kind") == "bcca" for r in rows)
+
+
+def _by_speed(rows: list[dict]):
+    """(v_col, the rows at it, its colour) for each speed, slowest first."""
+    speeds = sorted({r["v_col"] for r in rows})
+    for k, v in enumerate(speeds):
+        yield v, [r for r in rows if r["v_col"] == v], f"C{k % 10}"
+
+
+def _label_b_off(ax, x, y, rows):
+    for xi, yi, r in zip(x, y, rows):
+        ax.annotate(f"{r['B_off']:.2g}", (xi, yi), textcoords="offset points", xytext=(3, 3),
+                    fontsize=6, color="0.3")
+
+
 def compression(path, rows: list[dict]):
-    """r_g / (r_1 sqrt(N_lar)) and n_con against E_imp / (n_k E_roll), one point per run."""
+    """r_g / (r_1 sqrt(N_lar)) and n_con against E_imp / (n_k E_roll), one point per run,
+    coloured by v_col and labelled with B_off; eqs. (51) and (56) only for 2D BCCAs."""
     plt = _pyplot()
-    x = np.array([r["E_imp_over_nk_Eroll"] for r in rows], dtype=float)
-    rg = np.array([r["gyration_radius_largest"] / (r["radius"] * np.sqrt(r["n_largest"]))
-                   for r in rows])
-    ncon = np.array([r["contacts_per_particle"] for r in rows])
     fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4.5), constrained_layout=True)
-    e = np.logspace(np.log10(max(x.min(), 1e-3)) - 0.5, np.log10(x.max()) + 0.5, 50)
-    a.loglog(x, rg, "o")
-    a.loglog(e, 0.84 * e ** -0.12, "0.6", label="eq. (51), 2D BCCA")
+    x_all = np.array([r["E_imp_over_nk_Eroll"] for r in rows], dtype=float)
+    for v, mine, colour in _by_speed(rows):
+        x = np.array([r["E_imp_over_nk_Eroll"] for r in mine], dtype=float)
+        rg = np.array([r["gyration_radius_largest"] / (r["radius"] * np.sqrt(r["n_largest"]))
+                       for r in mine])
+        ncon = np.array([r["contacts_per_particle"] for r in mine])
+        a.loglog(x, rg, "o", color=colour, label=f"v = {v:g} m/s")
+        b.loglog(x, np.where(ncon > 1, ncon - 1, np.nan), "o", color=colour,
+                 label=f"v = {v:g} m/s")
+        _label_b_off(a, x, rg, mine)
+        _label_b_off(b, x, ncon - 1, mine)
+    if _two_d_bcca(rows):
+        e = np.logspace(np.log10(max(x_all.min(), 1e-3)) - 0.5, np.log10(x_all.max()) + 0.5, 50)
+        a.loglog(e, 0.84 * e ** -0.12, "0.6", label="eq. (51), 2D BCCA")
+        b.loglog(e, e ** 0.75, "0.6", label="eq. (56), 2D BCCA")
     a.set_ylabel("r_g / (r_1 N_lar^1/2)")
-    b.loglog(x, ncon - 1, "o")
-    b.loglog(e, e ** 0.75, "0.6", label="eq. (56), 2D BCCA")
     b.set_ylabel("n_con - 1")
     for ax in (a, b):
-        ax.set_xlabel("E_imp / (n_k E_roll)")
-        ax.legend()
+        ax.set_xlabel("E_imp / (n_k E_roll)   (labels: B_off)")
+        ax.legend(fontsize=8)
     return _save(fig, path)
 
 
 def disruption(path, rows: list[dict]):
-    """N_lar / N_total against E_imp / (n_k E_break), with the DT recipe's 3 and 10."""
+    """N_lar / N_total against E_imp / (n_k E_break), coloured by v_col and labelled with
+    B_off; for 2D BCCAs the marks of Wada et al. (2007) at 3 and 10 n_k E_break."""
     plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(6, 4.5), constrained_layout=True)
-    x = [r["E_imp_over_nk_Ebreak"] for r in rows]
-    y = [r["n_largest"] / r["n_total"] for r in rows]
-    ax.semilogx(x, y, "o")
-    for mark, text in [(3, "loss of one grain"), (10, "catastrophic")]:
-        ax.axvline(mark, color="0.6", ls=":")
-        ax.text(mark, 0.02, text, rotation=90, fontsize=8)
-    ax.set_xlabel("E_imp / (n_k E_break)")
+    fig, ax = plt.subplots(figsize=(6.5, 4.5), constrained_layout=True)
+    for v, mine, colour in _by_speed(rows):
+        x = [r["E_imp_over_nk_Ebreak"] for r in mine]
+        y = [r["n_largest"] / r["n_total"] for r in mine]
+        ax.semilogx(x, y, "o", color=colour, label=f"v = {v:g} m/s")
+        _label_b_off(ax, x, y, mine)
+    if _two_d_bcca(rows):
+        for mark, text in [(3, "loss of one grain"), (10, "catastrophic")]:
+            ax.axvline(mark, color="0.6", ls=":")
+            ax.text(mark, 0.02, text + " (2D BCCA)", rotation=90, fontsize=8)
+    ax.set_xlabel("E_imp / (n_k E_break)   (labels: B_off)")
     ax.set_ylabel("N_lar / N_total")
     ax.set_ylim(0, 1.05)
+    ax.legend(fontsize=8)
     return _save(fig, path)
 
 
-def growth_efficiency(path, curves: dict, thresholds: dict):
-    """<f_gro> against v_col for each model; ``curves[model] = (v, mean f_gro)``."""
+def growth_efficiency(path, curves: dict, thresholds: dict, runs: dict | None = None):
+    """<f_gro> against v_col for each model; ``curves[model] = (v, mean f_gro)``, each point
+    labelled with its number of runs (``runs[model]``, one count per point)."""
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(6, 4.5), constrained_layout=True)
     for model, (v, f) in curves.items():
         line, = ax.semilogx(v, f, "o-", label=model)
+        for k, (vi, fi) in enumerate(zip(v, f)):
+            if runs and model in runs:
+                ax.annotate(f"{runs[model][k]} runs", (vi, fi), textcoords="offset points",
+                            xytext=(4, 4), fontsize=7, color=line.get_color())
         if thresholds.get(model):
-            ax.axvline(thresholds[model], color=line.get_color(), ls=":")
+            ax.axvline(thresholds[model], color=line.get_color(), ls=":",
+                       label=f"v_fra = {thresholds[model]:.3g} m/s")
+    from matplotlib.ticker import NullFormatter, ScalarFormatter
+
+    ax.set_xticks(sorted({vi for v, _ in curves.values() for vi in v}))   # the grid's speeds
+    ax.xaxis.set_major_formatter(ScalarFormatter())
+    ax.xaxis.set_minor_formatter(NullFormatter())
     ax.axhline(0, color="0.6", lw=0.8)
     ax.set_xlabel("v_col (m/s)")
     ax.set_ylabel("<f_gro>")
-    ax.legend()
+    ax.legend(fontsize=8)
     return _save(fig, path)
 
 
 def cumulative(path, curves: dict):
-    """<N_cum(<= N)> against N; ``curves[label] = (N, mean N_cum)``."""
+    """<N_cum(<= N)> against N; ``curves[label] = (N, mean N_cum)``. Each curve is drawn as
+    steps with a marker at every rise, so that a run whose grains all sit in one remnant
+    (a single rise at N = N_total) shows too."""
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(6, 4.5), constrained_layout=True)
-    for label, (n, c) in curves.items():
-        c = np.asarray(c, dtype=float)
-        ax.loglog(n, np.where(c > 0, c, np.nan), drawstyle="steps-post", label=label)
+    for k, (label, (n, c)) in enumerate(curves.items()):
+        n, c = np.asarray(n, dtype=float), np.asarray(c, dtype=float)
+        rise = np.flatnonzero(np.diff(np.r_[0.0, c]) > 0)
+        line, = ax.loglog(n, np.where(c > 0, c, np.nan), drawstyle="steps-post")
+        ax.loglog(n[rise], c[rise], "osD^v<>"[k % 7], ms=5, color=line.get_color(),
+                  mfc="none", label=label)
     ax.set_xlabel("N")
     ax.set_ylabel("<N_cum(<= N)>")
     ax.legend(fontsize=8)

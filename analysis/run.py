@@ -12,20 +12,20 @@ MDAnalysis AnalysisBase), the energy ledger (analysis.thermo) and the writers
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 
-from jkrdt.materials import from_dict, scales
+from jkrdt import scene as scene_module
+from jkrdt.ledger import CHANNELS, energy_budget, energy_error
 from jkrdt.stopping import ENERGY_WARN, STOP_WORDS
 
 from .dumps import atoms_universe
 from .outcome import CollisionOutcome, energy_scalings
-from .plots import energy_partition, snapshot
+from .plots import energy_partition, outcome, timeline
 from .status import run_status
 from .tables import write_csv, write_json
-from .thermo import CHANNELS, energy_budget, energy_error, read_thermo
+from .thermo import read_thermo
 
 
 class RunNotComplete(ValueError):
@@ -39,17 +39,17 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
     cut off (see ``analysis.status``) raises ``RunNotComplete`` unless ``partial``, which
     analyses the frames there are and records the stop reason."""
     run = Path(run)
-    if not (run / "collision.json").exists():
+    if not (run / scene_module.META).exists():
         raise FileNotFoundError(f"{run} has no collision.json: analyse a directory written by "
-                                "'jkrdt setup' (or jkrdt.collision.write) and run there")
+                                "'jkrdt setup' (jkrdt.scene.write) and run there")
+    meta = scene_module.read_metadata(run)
+    scene = scene_module.from_metadata(meta)
     status = run_status(run)
     if status.stop_reason == "error" and not partial:
         raise RunNotComplete(f"{run}: {status.problem}; analyse what is there with --partial")
-    meta = json.loads((run / "collision.json").read_text())
-    mat = from_dict(meta["material"])
-    s = scales(mat, meta["radius"])
+    mat, s = scene.material, scene.scales
     tolerance = s.delta_c if tolerance is None else tolerance
-    n_tar, n_pro = meta["N_tar"], meta["N_pro"]
+    n_tar, n_pro = scene.n_tar, scene.n_pro
     budget, thermo = None, None
     if (run / "log.lammps").exists():
         thermo = read_thermo(run / "log.lammps")
@@ -78,10 +78,10 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
         raise RunNotComplete(f"{run}: {status.problem}; analyse what is there with --partial")
     n_k = n_tar + n_pro - 2
     sizes, cumulative = measured.fragment_sizes, measured.N_cum
-    out = dict(run=str(run), N_tar=n_tar, N_pro=n_pro, v_col=meta["v_col"],
-               B_off=meta["B_off"], seed=meta.get("seed"), model=meta.get("model"),
-               kind=meta.get("kind"), dimension=meta["dimension"],
-               material=mat.name, xi_crit=mat.xi_crit, tvis=mat.tvis, radius=meta["radius"],
+    out = dict(run=str(run), N_tar=n_tar, N_pro=n_pro, v_col=scene.v_col,
+               B_off=scene.b_off, seed=scene.seed, model=scene.model,
+               kind=scene.kind, dimension=scene.dim,
+               material=mat.name, xi_crit=mat.xi_crit, tvis=mat.tvis, radius=scene.radius,
                E_imp=meta["E_imp"], n_k=n_k, E_roll=s.E_roll, E_break=s.E_break,
                **energy_scalings(meta["E_imp"], n_k, s.E_roll, s.E_break),
                **final, fragment_sizes=sizes.tolist(), N_cum=cumulative.tolist(),
@@ -105,17 +105,22 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
                                           for name in CHANNELS})
     write_csv(run / "frames.csv", rows)
     if plots:
-        title = (f"{mat.name} {(meta.get('kind') or '').upper()} {n_tar}+{n_pro}, "
-                 f"v = {meta['v_col']:g} m/s, B_off = {meta['B_off']:g}, {meta.get('model', '')}")
+        title = (f"{mat.name} {scene.kind.upper()} {n_tar}+{n_pro}, "
+                 f"v = {scene.v_col:g} m/s, B_off = {scene.b_off:g}, {scene.model}")
         when = f"{status.stop_reason} at step {last_step}"
         if "time_end" in out:
             when += (f", t = {out['time_end'] * 1e9:.0f} ns = {out['time_end_over_tc']:.0f} t_c; "
                      f"max |dE|/E_imp = {out['energy_error']:.1e}")
-        out["pictures"] = [str(p) for p in snapshot(run / "outcome", x_last, labels,
-                                                    f"{title}\n{when}", radius=meta["radius"])]
+        step_s = scene.time_step()[0] * s.t_c          # the time of a frame without a log
+        moments = [(r["step"], r.get("time", r["step"] * step_s)) for r in (rows[0], rows[-1])]
+        pictures = outcome(run / "outcome", measured.first_positions, x_last, measured.types,
+                           labels, scene.radius, scene.dim, moments, s.t_c, b=meta.get("b"),
+                           title=f"{title}\n{when}")
+        pictures += timeline(run / "timeline", rows, n_tar + n_pro, meta["E_imp"], s.t_c, title)
         if budget is not None:
-            out["pictures"] += [str(p) for p in energy_partition(run / "energy", thermo["Time"],
-                                                                 budget, meta["E_imp"], title)]
+            pictures += energy_partition(run / "energy", thermo["Time"], budget, meta["E_imp"],
+                                         title)
+        out["pictures"] = [str(p) for p in pictures]
     write_json(run / "outcome.json", out)
     return out
 

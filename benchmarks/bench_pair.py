@@ -35,6 +35,7 @@ import time
 from pathlib import Path
 
 from jkrdt.materials import ICE, scales
+from jkrdt.scene import pair_coeff
 
 R = 1.0e-7
 BIN = Path(sys.executable).parent
@@ -56,8 +57,8 @@ run {steps}
 """
 K_ROLL = 12 * 3.141592653589793 * ICE.gamma        # eq. (22): 4 F_c / R
 GRANULAR_JKR = f"pair_coeff * * jkr {ICE.E!r} 0.0 {ICE.nu!r} {ICE.gamma!r} damping velocity "
-JKRDT_FULL = "pair_style jkr/dt\npair_coeff * * " + ICE.pair_coeff()
-JKRDT_BARE = "pair_style jkr/dt\npair_coeff * * " + ICE.pair_coeff(frictionless=True)
+JKRDT_FULL = "pair_style jkr/dt\npair_coeff * * " + pair_coeff(ICE)
+JKRDT_BARE = "pair_style jkr/dt\npair_coeff * * " + pair_coeff(ICE, "frictionless")
 STYLES = {
     "jkr/dt full": JKRDT_FULL,
     "granular full": (

@@ -28,8 +28,9 @@ import numpy as np
 from jkrdt.aggregates import bpca
 from jkrdt.datafile import write_sphere_data
 from jkrdt.materials import ICE, QUARTZ, scales
+from jkrdt.scene import pair_coeff
 from jkrdt.session import read_deck, start_lammps
-from jkrdt.analysis.thermo import CONSERVED
+from jkrdt.ledger import CONSERVED
 
 KICK = 0.01          # initial kinetic energy per grain, in F_c delta_c
 RATIOS = [0.05, 0.1, 0.2, 0.3, 0.35, 0.4, 0.45, 0.5, 0.6, 0.7, 0.8, 1.0, 1.2, 1.5]
@@ -45,13 +46,12 @@ def resting_run(mat, model: str, ratio: float, n: int, steps: int, seed: int = 1
     v_scale = np.sqrt(KICK * s.F_c * s.delta_c / s.mass)
     v = rng.normal(size=x.shape) * v_scale / np.sqrt(3)
     omega = rng.normal(size=x.shape) * v_scale / (np.sqrt(0.4) * r) / np.sqrt(3)
-    words = "frictionless" if model == "frictionless" else f"xi_crit {mat.xi_crit!r}"
     with tempfile.TemporaryDirectory() as tmp:
         data = Path(tmp) / "agg.data"
         write_sphere_data(data, x, r, mat.density, v=v, omega=omega)
         lmp = start_lammps()
         try:
-            read_deck(lmp, dict(file=data, gamma=mat.gamma, E=mat.E, nu=mat.nu, model=words,
+            read_deck(lmp, dict(file=data, coeffs=pair_coeff(mat, model),
                                 dt=ratio * s.t_c, skin=10 * s.delta_c, dt_check="off"))
             lmp.command(f"variable total equal {CONSERVED}")
             lmp.command("run 0 post no")

@@ -65,23 +65,14 @@ MODELS = {"frictional": dict(model="frictional", tvis=0.0),
 
 def write_scene(directory: Path, scene: dict, seed: int, n: int | None = None,
                 model: str | None = None, tvis: float = 0.0) -> Path:
-    from jkrdt import collision
-    from jkrdt.aggregates import bcca, bpca
-    from jkrdt.materials import material, scales
+    from jkrdt import scene as scene_module
+    from jkrdt.materials import material
 
-    mat = material("ice", xi_crit=scene["xi_crit"], tvis=tvis)
-    r = 1.0e-7
-    s = scales(mat, r)
-    rng = np.random.default_rng(seed)
-    build = {"bpca": bpca, "bcca": bcca}[scene["kind"]]
     n = n or scene["n"]
-    tar, pro = build(n, r, s.delta0, rng, dim=scene["dim"]), build(n, r, s.delta0, rng,
-                                                                     dim=scene["dim"])
-    c = collision.set_up(tar, pro, r, v_col=scene["v"], b_off=scene["b_off"], rng=rng,
-                         material=mat, dim=scene["dim"], seed=seed)
-    c.meta.update(kind=scene["kind"], model=model or scene["model"])
-    collision.write(c, mat, directory)
-    return directory
+    return scene_module.write(directory, scene_module.Scene(
+        material("ice", xi_crit=scene["xi_crit"], tvis=tvis), n, n, v_col=scene["v"],
+        b_off=scene["b_off"], seed=seed, kind=scene["kind"], dim=scene["dim"],
+        model=model or scene["model"]))
 
 
 def one_run(job: dict) -> dict:

@@ -52,6 +52,7 @@ FixJKRDTSettle::FixJKRDTSettle(LAMMPS *lmp, int narg, char **arg) :
     }
   }
   if (cap > 0.0) cap += simulated_time();    // the cap counts from the fix's definition
+  restart_global = 1;
   vector_flag = 1;
   size_vector = 5;
   global_freq = 1;
@@ -197,4 +198,39 @@ double FixJKRDTSettle::compute_vector(int n)
     case 3: return static_cast<double>(now.contacts);
     default: return static_cast<double>(last_check);
   }
+}
+
+/* ----------------------------------------------------------------------
+   restart: the last check and the window's partitions
+------------------------------------------------------------------------- */
+
+void FixJKRDTSettle::write_restart(FILE *fp)
+{
+  std::vector<double> list = {static_cast<double>(last_check),
+                              static_cast<double>(history.size())};
+  for (const auto &h : history) {
+    list.push_back(static_cast<double>(h.n_largest));
+    list.push_back(static_cast<double>(h.n_fragments));
+    list.push_back(static_cast<double>(h.contacts));
+    list.push_back(h.dissipated);
+  }
+  if (comm->me == 0) {
+    int size = static_cast<int>(list.size() * sizeof(double));
+    fwrite(&size, sizeof(int), 1, fp);
+    fwrite(list.data(), sizeof(double), list.size(), fp);
+  }
+}
+
+void FixJKRDTSettle::restart(char *buf)
+{
+  auto *list = reinterpret_cast<double *>(buf);
+  last_check = static_cast<bigint>(list[0]);
+  const int n = static_cast<int>(list[1]);
+  history.clear();
+  for (int k = 0; k < n; k++) {
+    const double *p = list + 2 + 4 * k;
+    history.push_back({static_cast<bigint>(p[0]), static_cast<bigint>(p[1]),
+                       static_cast<bigint>(p[2]), p[3]});
+  }
+  if (!history.empty()) now = history.back();
 }

@@ -19,7 +19,9 @@
    and the global vector holds: 1 state (0 running, 1 settled, 2 cap),
    2 N_lar, 3 fragments, 4 bonded contacts, 5 the step of the last check.
    The window carries over from one run to the next (a run in chunks) unless
-   the step count goes back; it is not carried through restart files.      */
+   the step count goes back. It is carried through restart files (to a fix
+   of the same ID defined after read_restart), so a run continued from one
+   with the remaining cap stops where the uninterrupted run would have.    */
 
 #ifndef JKR_DT_FIX_SETTLE_H
 #define JKR_DT_FIX_SETTLE_H
@@ -45,6 +47,8 @@ class FixJKRDTSettle : public Fix {
   void end_of_step() override;
   void post_run() override;
   double compute_vector(int) override;
+  void write_restart(FILE *) override;
+  void restart(char *) override;
 
  private:
   int window;                    // K checks

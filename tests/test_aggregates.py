@@ -11,6 +11,7 @@ from conftest import ICE_SCALES as S, R_GRAIN
 from jkrdt.aggregates import bcca, bonds, bpca, fractal_fit, gyration_radius, stick_head_on
 from jkrdt.datafile import write_sphere_data
 from jkrdt.materials import ICE
+from jkrdt.scene import pair_coeff
 from jkrdt.session import start_lammps
 
 BOND = 2 * R_GRAIN - S.delta0
@@ -98,7 +99,7 @@ def test_lammps_reads_aggregates_at_rest_with_zero_force(tmp_path, dim):
             comm_modify vel yes
             read_data {data}
             pair_style jkr/dt
-            pair_coeff * * {ICE.pair_coeff()}
+            pair_coeff * * {pair_coeff(ICE)}
             neighbor 1e-8 bin
             compute p all pair jkr/dt
             thermo_style custom step pe c_p[10]

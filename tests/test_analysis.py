@@ -7,7 +7,7 @@ import pytest
 from conftest import ICE_SCALES as S, R_GRAIN as R
 from jkrdt.aggregates import bonds, bpca, gyration_radius
 from jkrdt.analysis import fragments as frag
-from jkrdt.analysis.campaign import b_off_average, cumulative_on, threshold_velocity
+from jkrdt.analysis.summary import b_off_average, cumulative_on, threshold_velocity
 from jkrdt.analysis.outcome import measure
 
 BOND = 2 * R - S.delta0

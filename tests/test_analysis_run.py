@@ -12,8 +12,7 @@ import numpy as np
 import pytest
 
 from conftest import ICE_SCALES as S, R_GRAIN as R
-from jkrdt import collision
-from jkrdt.aggregates import bpca
+from jkrdt import scene as scene_module
 from jkrdt.analysis import fragments as frag
 from jkrdt.analysis.dumps import frames, iter_local
 from jkrdt.analysis.run import analyse_run
@@ -27,12 +26,9 @@ N = 64
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory):
-    rng = np.random.default_rng(11)
-    c = collision.set_up(bpca(N, R, S.delta0, rng), bpca(N, R, S.delta0, rng), R, v_col=60.0,
-                         b_off=0.0, rng=rng, material=ICE, seed=11)
-    c.meta.update(kind="bpca", model="frictionless")
     d = tmp_path_factory.mktemp("run")
-    collision.write(c, ICE, d)
+    scene_module.write(d, scene_module.Scene(ICE, N, N, v_col=60.0, seed=11,
+                                             model="frictionless"))
     with Session(d, d, every=1000) as session:
         session.run(12000, chunk=1000, progress=False)
         energies, thermo = session.energies(), session.thermo()
@@ -118,7 +114,8 @@ def test_analyse_command(run):
                           text=True, check=True, timeout=120)
     out = json.loads((d / "outcome.json").read_text())
     assert f"largest remnant N_lar       {out['n_largest']}" in done.stdout
-    for name in ("outcome.png", "outcome.pdf", "energy.png", "energy.pdf"):
+    for name in ("outcome.png", "outcome.pdf", "timeline.png", "timeline.pdf", "energy.png",
+                 "energy.pdf"):
         assert (d / name).stat().st_size > 0
 
 

@@ -1,17 +1,23 @@
 """A small campaign end to end: v_col x B_off^2 runs, resumed without redoing finished
-runs, summarised with eq. (1) of the 3D BPCA paper, and the same under mpirun -np 2."""
+runs, summarised with eq. (1) of the 3D BPCA paper; under mpirun -np 2 two runs at once
+with the serial campaign's results; a killed campaign resumed from its restart files; two
+campaigns on one directory sharing its runs."""
 
 import json
+import os
+import re
+import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from jkrdt.analysis.campaign import b_off_average, summarise
+from jkrdt.analysis.summary import b_off_average, summarise
 from jkrdt.analysis.tables import read_csv
-from jkrdt.campaign import run_campaign
+from jkrdt.campaign import run_campaign, run_directory
 
 BIN = Path(sys.executable).parent
 SPEC = dict(kind="bpca", dim=3, n_tar=16, n_pro=16, material="ice", model="frictional",
@@ -75,18 +81,103 @@ def test_summary_is_the_b_off_weighted_average(campaign):
     assert slow["mean_f_gro"] > 0
 
 
-@pytest.mark.mpi
-def test_campaign_under_two_ranks_matches_serial(campaign, tmp_path):
-    spec, runs, _ = campaign
-    subprocess.run([str(BIN / "mpirun"), "-np", "2", str(BIN / "jkrdt"), "campaign", str(spec),
-                    str(tmp_path), "--quiet"], check=True, timeout=600)
+def same_outcomes(runs, other):
     for path in sorted(runs.rglob("outcome.json")):
         serial = json.loads(path.read_text())
-        parallel = json.loads((tmp_path / path.relative_to(runs)).read_text())
+        parallel = json.loads((other / path.relative_to(runs)).read_text())
         for key in ("n_largest", "n_second", "n_fragments", "contacts_per_particle"):
             assert parallel[key] == serial[key], (path, key)
         assert parallel["gyration_radius_largest"] == pytest.approx(
             serial["gyration_radius_largest"], rel=1e-9)
+
+
+def spans(runs):
+    """(claiming process, start, end) of each run: its scene written, its outcome written."""
+    out = []
+    for d in {p.parent for p in runs.rglob("outcome.json")}:
+        who = (d / ".claim").read_text().split()[2]
+        out.append((who, (d / "collision.json").stat().st_mtime,
+                    (d / "outcome.json").stat().st_mtime))
+    return out
+
+
+@pytest.mark.mpi
+def test_campaign_under_two_ranks_matches_serial(campaign, tmp_path):
+    spec, runs, _ = campaign
+    done = subprocess.run([str(BIN / "mpirun"), "-np", "2", str(BIN / "jkrdt"), "campaign",
+                           str(spec), str(tmp_path)], check=True, timeout=600,
+                          capture_output=True, text=True)
+    same_outcomes(runs, tmp_path)
+    # groups of one rank: each rank ran whole collisions, at the same time as the other
+    said = re.findall(r"^\[ranks (\d)-(\d)\]", done.stdout, re.M)
+    assert sorted(set(said)) == [("0", "0"), ("1", "1")] and len(said) == 6, done.stdout
+    mine = spans(tmp_path)
+    assert len({who for who, *_ in mine}) == 2
+    assert any(a[0] != b[0] and a[1] < b[2] and b[1] < a[2] for a in mine for b in mine)
+
+
+@pytest.mark.mpi
+def test_a_group_of_two_ranks_runs_each_collision_in_parallel(campaign, tmp_path):
+    spec, runs, _ = campaign
+    done = subprocess.run([str(BIN / "mpirun"), "-np", "2", str(BIN / "jkrdt"), "campaign",
+                           str(spec), str(tmp_path), "--ranks-per-run", "2"], check=True,
+                          timeout=600, capture_output=True, text=True)
+    assert set(re.findall(r"^\[ranks (\d-\d)\]", done.stdout, re.M)) == {"0-1"}
+    same_outcomes(runs, tmp_path)
+    bad = subprocess.run([str(BIN / "mpirun"), "-np", "2", str(BIN / "jkrdt"), "campaign",
+                          str(spec), str(tmp_path / "bad"), "--ranks-per-run", "3"],
+                         capture_output=True, text=True, timeout=120)
+    assert bad.returncode != 0 and "Traceback" not in bad.stderr
+    assert "jkrdt: --ranks-per-run 3 must divide the 2 MPI rank(s) into equal groups" \
+        in bad.stderr
+
+
+def test_two_campaigns_on_one_directory_share_its_runs(campaign, tmp_path):
+    spec, runs, _ = campaign
+    both = [subprocess.Popen([str(BIN / "jkrdt"), "campaign", str(spec), str(tmp_path),
+                              "--quiet"], stdout=subprocess.PIPE, text=True)
+            for _ in range(2)]
+    said = [p.communicate(timeout=600)[0] for p in both]
+    assert all(p.returncode == 0 for p in both)
+    ran = [int(re.match(r"(\d+) run\(s\) done", s).group(1)) for s in said]
+    assert sum(ran) == 6, said                   # no run done twice, none left out
+    for log in tmp_path.rglob("log.lammps"):
+        assert log.read_text().count("LAMMPS (") == 1, log
+    same_outcomes(runs, tmp_path)
+
+
+KILLED = dict(SPEC, n_tar=64, n_pro=64, v_col=[20.0], b_off2=[0.25],
+              settle=dict(check_tc=5, cap_tc=4000))
+
+
+def test_a_killed_campaign_resumes_from_its_restart_file(tmp_path):
+    spec = tmp_path / "spec.json"
+    spec.write_text(json.dumps(KILLED))
+    run_campaign(spec, tmp_path / "whole", progress=False)
+    cut = tmp_path / "cut"
+    run = run_directory(cut, 20.0, 0.25, 2)
+    proc = subprocess.Popen([str(BIN / "jkrdt"), "campaign", str(spec), str(cut), "--quiet"],
+                            start_new_session=True)
+    deadline = time.time() + 120
+    while not (run / "restart.b").exists() and time.time() < deadline:
+        time.sleep(0.02)
+    time.sleep(0.3)                               # a few more checks, then the kill
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+    assert not (run / "outcome.json").exists(), "the run ended before it could be killed"
+    assert run_campaign(spec, cut, progress=False) == dict(runs=1, skipped=0, ran=1)
+    log = (run / "log.lammps").read_text()
+    assert log.count("Reading restart file") == 1     # continued, not started again
+    whole = json.loads(next((tmp_path / "whole").rglob("outcome.json")).read_text())
+    again = json.loads((run / "outcome.json").read_text())
+    # the continuation is the uninterrupted run: same stop, same outcome, same ledger
+    for key in ("stop_reason", "stop_step", "n_largest", "n_fragments", "contacts_per_particle"):
+        assert again[key] == whole[key], key
+    assert again["gyration_radius_largest"] == pytest.approx(whole["gyration_radius_largest"],
+                                                              rel=1e-12)
+    assert again["dissipated_fraction"] == pytest.approx(whole["dissipated_fraction"], rel=1e-9)
+    frames = [r["step"] for r in read_csv(run / "frames.csv")]
+    assert frames == [r["step"] for r in read_csv(whole["run"] + "/frames.csv")]
 
 
 def test_spec_errors_name_the_fix(tmp_path):

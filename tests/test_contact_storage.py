@@ -5,6 +5,7 @@ import pytest
 
 from conftest import ENERGY_THERMO, ICE_SCALES as S, R_GRAIN, ledger
 from jkrdt.materials import ICE
+from jkrdt.scene import pair_coeff
 
 U_EQUILIBRIUM = -0.8 * 6 ** (1 / 3) * S.F_c * S.delta_c      # eq. (6) at a = a0
 
@@ -36,7 +37,7 @@ def test_twelve_contacts_on_one_grain(lmp):
         set type 1 diameter {2 * R_GRAIN!r}
         set type 1 density {ICE.density!r}
         pair_style jkr/dt
-        pair_coeff * * {ICE.pair_coeff(frictionless=True)}
+        pair_coeff * * {pair_coeff(ICE, 'frictionless')}
         neighbor {S.delta_c!r} bin
         compute p all pair jkr/dt
         compute erot all erotate/sphere

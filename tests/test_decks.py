@@ -10,7 +10,8 @@ from pathlib import Path
 import pytest
 
 from conftest import ICE_SCALES as S
-from jkrdt.analysis.thermo import energy_budget, read_thermo
+from jkrdt.analysis.thermo import read_thermo
+from jkrdt.ledger import energy_budget
 
 ROOT = Path(__file__).resolve().parents[1]
 BIN = Path(sys.executable).parent

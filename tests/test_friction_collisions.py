@@ -6,8 +6,7 @@ import numpy as np
 import pytest
 
 from conftest import ENERGY_THERMO, ledger
-from jkrdt import collision
-from jkrdt.aggregates import bpca
+from jkrdt import scene as scene_module
 from jkrdt.materials import ICE, scales
 from jkrdt.session import start_lammps
 
@@ -17,11 +16,8 @@ FRICTIONAL = f"xi_crit {ICE.xi_crit!r}"
 
 
 def write_scene(directory, n, v_col, b_off, dim=3, seed=7):
-    rng = np.random.default_rng(seed)
-    tar = bpca(n, R, S.delta0, rng, dim=dim)
-    pro = bpca(n, R, S.delta0, rng, dim=dim)
-    c = collision.set_up(tar, pro, R, v_col=v_col, b_off=b_off, rng=rng, material=ICE, dim=dim)
-    return collision.write(c, ICE, directory)
+    scene = scene_module.Scene(ICE, n, n, v_col=v_col, b_off=b_off, seed=seed, dim=dim)
+    return scene_module.write(directory, scene) / scene_module.DATA
 
 
 def momenta(lmp):

@@ -3,6 +3,7 @@ restarts: the same aggregate collision gives the same trajectory to round-off.
 Every test runs with the frictionless model and with the frictional one, whose
 contacts also carry the pointers n1, n2 and the twisting angle."""
 
+import dataclasses
 import os
 import subprocess
 import sys
@@ -11,8 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from jkrdt import collision
-from jkrdt.aggregates import bpca
+from jkrdt import scene as scene_module
 from jkrdt.analysis.dumps import last_local_snapshot
 from jkrdt.materials import ICE, scales
 
@@ -23,7 +23,7 @@ S = scales(ICE, R)
 STEPS = 4000      # long enough for ~1000 contacts to form, several to break, atoms to migrate
 
 
-MODELS = {"frictionless": "frictionless", "frictional": f"xi_crit {ICE.xi_crit!r}"}
+MODELS = {"frictionless": "frictionless", "frictional": "frictional"}
 
 
 @pytest.fixture(scope="module", params=list(MODELS))
@@ -33,20 +33,19 @@ def model(request):
 
 @pytest.fixture(scope="module")
 def scene(tmp_path_factory):
-    rng = np.random.default_rng(7)
-    tar = bpca(150, R, S.delta0, rng)
-    pro = bpca(150, R, S.delta0, rng)
-    c = collision.set_up(tar, pro, R, v_col=20.0, b_off=0.3, rng=rng, material=ICE)
     d = tmp_path_factory.mktemp("scene")
-    return collision.write(c, ICE, d)
+    scene_module.write(d, scene_module.Scene(ICE, 150, 150, v_col=20.0, b_off=0.3, seed=7))
+    return d / scene_module.DATA
 
 
-def run_deck(workdir, data, model, nproc=1, steps=STEPS, restart=None, extra=(), threads=1):
+def run_deck(workdir, data, model, nproc=1, steps=STEPS, restart=None, extra=(), threads=1,
+             tvis=0.0):
     workdir.mkdir(parents=True, exist_ok=True)
     cmd = [str(BIN / "lmp"), "-in", str(DECK), "-log", str(workdir / "log.lammps"),
            "-screen", "none",
            "-var", "file", str(restart or data), "-var", "out", str(workdir),
-           "-var", "model", model,
+           "-var", "coeffs", scene_module.pair_coeff(dataclasses.replace(ICE, tvis=tvis), model),
+           "-var", "dt", repr(0.014 * S.t_c),
            "-var", "steps", str(steps), "-var", "every", "500", *extra]
     if restart:
         cmd += ["-var", "read", "read_restart"]
@@ -115,14 +114,13 @@ def test_newton_on_matches_off(serial, scene, model, tmp_path):
     assert dx < 1e-6 and dv < 1e-6
 
 
-@pytest.mark.parametrize("tvis", ["0", "6e-12"])
+@pytest.mark.parametrize("tvis", [0.0, 6e-12])
 def test_restart_continues_exactly(scene, model, tmp_path, tvis):
-    damping = ("-var", "tvis", tvis)
-    straight = run_deck(tmp_path / "straight", scene, model, extra=damping)
+    straight = run_deck(tmp_path / "straight", scene, model, tvis=tvis)
     first = tmp_path / "first"
-    run_deck(first, scene, model, steps=STEPS // 2, extra=damping)
+    run_deck(first, scene, model, steps=STEPS // 2, tvis=tvis)
     cont = run_deck(tmp_path / "second", scene, model, steps=STEPS // 2,
-                    restart=first / "final.restart", extra=damping)
+                    restart=first / "final.restart", tvis=tvis)
     dx, dv = scale_error(straight, cont)
     assert dx == 0.0 and dv == 0.0     # same arithmetic in the same order: bitwise equal
     # the dissipation ledger continues too: compare the contacts' forces at the end

@@ -11,10 +11,9 @@ import numpy as np
 import pytest
 
 from conftest import ICE_SCALES as S, R_GRAIN, ledger, two_grain_scene
-from jkrdt import collision
-from jkrdt.aggregates import bpca
+from jkrdt import scene as scene_module
 from jkrdt.materials import ICE
-from jkrdt.session import start_lammps, write_scene_deck
+from jkrdt.session import start_lammps
 
 BIN = Path(sys.executable).parent
 READ_BACK = """units si
@@ -102,14 +101,9 @@ def test_restart_files_written_before_owner_ids_continue():
 
 def test_scene_deck_continues_a_restart_with_the_scenes_model_and_dt(tmp_path):
     # the README's restart route: the scene's own deck, which carries its model and dt
-    rng = np.random.default_rng(21)
-    c = collision.set_up(bpca(40, R_GRAIN, S.delta0, rng), bpca(40, R_GRAIN, S.delta0, rng),
-                         R_GRAIN, v_col=30.0, b_off=0.2, rng=rng, material=ICE, seed=21)
-    c.meta.update(kind="bpca", model="frictionless", dt_over_tc=0.02,
-                  dt_reason="dt = 0.02 t_c given for the test")
-    scene = tmp_path / "scene"
-    collision.write(c, ICE, scene)
-    write_scene_deck(scene)
+    scene = scene_module.write(tmp_path / "scene", scene_module.Scene(
+        ICE, 40, 40, v_col=30.0, b_off=0.2, seed=21, model="frictionless", dt_over_tc=0.02,
+        dt_reason="dt = 0.02 t_c given for the test"))
     runs = {}
     for name in ("straight", "first", "second"):
         runs[name] = tmp_path / name

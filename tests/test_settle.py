@@ -13,9 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from jkrdt import collision
-from jkrdt.aggregates import bcca
-from jkrdt.analysis.campaign import summarise
+from jkrdt import scene as scene_module
+from jkrdt.analysis.summary import summarise
 from jkrdt.analysis.dumps import frames
 from jkrdt.analysis.fragments import from_contacts
 from jkrdt.analysis.run import RunNotComplete, analyse_run
@@ -32,13 +31,8 @@ RULE = SettleRule(check_tc=20, window=5, tolerance=0.01, cap_tc=6000)
 
 
 def write_scene(directory, v=10.0, seed=3, n=32):
-    rng = np.random.default_rng(seed)
-    tar, pro = bcca(n, R, S.delta0, rng, dim=2), bcca(n, R, S.delta0, rng, dim=2)
-    c = collision.set_up(tar, pro, R, v_col=v, b_off=0.0, rng=rng, material=ICE, dim=2,
-                         seed=seed)
-    c.meta.update(kind="bcca", model="frictional")
-    collision.write(c, ICE, directory)
-    return directory
+    scene = scene_module.Scene(ICE, n, n, v_col=v, seed=seed, kind="bcca", dim=2)
+    return scene_module.write(directory, scene)
 
 
 def settle_line(log):

@@ -17,7 +17,8 @@ from conftest import R_GRAIN, ledger, two_grain_scene
 from jkrdt.aggregates import bpca
 from jkrdt.datafile import write_sphere_data
 from jkrdt.materials import ICE, QUARTZ, scales
-from jkrdt.analysis.thermo import CONSERVED
+from jkrdt.ledger import CONSERVED
+from jkrdt.scene import pair_coeff
 from jkrdt.session import read_deck, start_lammps
 
 V_STICK = 1.9345      # v0
@@ -216,7 +217,8 @@ def test_resting_aggregate_drift_stays_bounded_over_a_million_steps(tmp_path):
     write_sphere_data(tmp_path / "a.data", x, r, ICE.density, v=v)
     lmp = start_lammps()
     try:
-        read_deck(lmp, dict(file=tmp_path / "a.data", dt=0.014 * s.t_c))    # ice, frictional
+        read_deck(lmp, dict(file=tmp_path / "a.data", dt=0.014 * s.t_c,
+                            coeffs=pair_coeff(ICE, "frictional")))
         lmp.command(f"variable total equal {CONSERVED}")
         lmp.command("run 0 post no")
         e0 = lmp.extract_variable("total")

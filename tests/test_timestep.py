@@ -11,7 +11,8 @@ from pathlib import Path
 import pytest
 
 from jkrdt import timestep
-from jkrdt.analysis.thermo import energy_budget, read_thermo
+from jkrdt.analysis.thermo import read_thermo
+from jkrdt.ledger import energy_budget
 from jkrdt.materials import ICE, scales
 
 BIN = Path(sys.executable).parent

@@ -212,3 +212,7 @@ def fractal_fit(n: np.ndarray, rg_over_r: np.ndarray) -> tuple[float, float]:
     Wada et al. 2007); returns (D_f, k0)."""
     slope, intercept = np.polyfit(np.log(rg_over_r), np.log(n), 1)
     return float(slope), float(np.exp(intercept))
+
+
+#: the aggregate builders by the name a scene gives them (``kind``)
+BUILDERS = {"bpca": bpca, "bcca": bcca}

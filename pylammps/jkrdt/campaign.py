@@ -1,5 +1,5 @@
 """Collision campaigns: a grid of v_col x B_off^2 x seeds, one run directory each,
-resumable.
+run side by side across MPI ranks, resumable.
 
 A spec (JSON) names the grid and the scene:
 
@@ -18,26 +18,39 @@ left out for the defaults, or given in part), or, with ``"settle": false``, afte
 ``"steps"`` steps, dumped every ``"every"`` steps. A run that fails is recorded with
 ``"stop_reason": "error"`` in its outcome.json and is not tried again.
 
-Each run goes to ``CAMPAIGN/v<v_col>/b2_<B_off^2>/seed<seed>``. A run is finished when
-its ``outcome.json`` exists; that file is written last, atomically, so an interrupted
-campaign started again skips every finished run and redoes only the run that was cut
-off (its restart files stay for a manual continuation). Target and projectile are
-built once per seed and shared by all v_col and B_off, as in the 3D BPCA paper.
+Each run goes to ``CAMPAIGN/v<v_col>/b2_<B_off^2>/seed<seed>`` as a scene directory
+(``jkrdt.scene``). Target and projectile are built once per seed and shared by all
+v_col and B_off, as in the 3D BPCA paper.
+
+Under ``mpirun -np N jkrdt campaign ... --ranks-per-run K`` the ranks form N/K groups;
+each group runs whole collisions on its own communicator, taking the next unclaimed run
+when it is free. A run is claimed by a lock on ``RUN/.claim`` held while it goes, which
+the system releases when its holder dies: two campaigns on one directory never run the
+same collision, and a killed campaign's runs are free again.
+
+A run is finished when its ``outcome.json`` exists; that file is written last,
+atomically, and is never replaced. A run that was cut off (no outcome.json, but a
+restart file) resumes from its newer whole restart file: its dumps and log are cut back
+to that step and appended to, and the settle rule's window comes back with the restart
+file, so the run ends as the uninterrupted one would have.
 """
 
 from __future__ import annotations
 
+import fcntl
 import json
+import os
+import socket
+import time
 from pathlib import Path
 
 import numpy as np
 
-from . import collision
-from .aggregates import bcca, bpca
-from .materials import material, scales
+from . import scene as scene_module
+from .aggregates import BUILDERS
+from .materials import material
+from .scene import Scene
 from .stopping import SettleRule
-
-BUILDERS = {"bpca": bpca, "bcca": bcca}
 DEFAULTS = dict(kind="bpca", dim=3, material="ice", material_overrides={}, radius=1.0e-7,
                 model="frictional", seeds=[1], dt=0.014, settle={}, steps=None, every=None)
 REQUIRED = ["n_tar", "n_pro", "v_col", "b_off2"]
@@ -124,14 +137,14 @@ def read_spec(path) -> dict:
     return spec
 
 
-def record_failure(directory: Path, v: float, b2: float, seed, error: str) -> None:
+def record_failure(directory: Path, seed, error: str) -> None:
     """outcome.json of a run that failed: its parameters and the error, no outcome."""
     from jkrdt.analysis.tables import write_json
 
-    meta = json.loads((directory / "collision.json").read_text())
+    meta = scene_module.read_metadata(directory)
     mat = meta["material"]
     write_json(directory / "outcome.json",
-               dict(run=str(directory), v_col=v, B_off=float(np.sqrt(b2)), seed=seed,
+               dict(run=str(directory), v_col=meta["v_col"], B_off=meta["B_off"], seed=seed,
                     model=meta.get("model"), material=mat["name"], xi_crit=mat["xi_crit"],
                     tvis=mat["tvis"], N_tar=meta["N_tar"], N_pro=meta["N_pro"],
                     stop_reason="error", settled=False, problem=error))
@@ -146,61 +159,198 @@ def plan(spec: dict, campaign) -> list[tuple[float, float, int, Path]]:
             for seed in spec["seeds"] for v in spec["v_col"] for b2 in spec["b_off2"]]
 
 
-def run_campaign(spec_path, campaign, progress: bool = True) -> dict:
-    """Run every unfinished run of the campaign; returns counts of done and skipped runs.
-    Works under ``mpiexec -n K``: each run uses all ranks, rank 0 writes the files."""
+def scene_of(spec: dict, v: float, b2: float, seed: int) -> Scene:
+    """The scene of one run of the grid."""
+    return Scene(material=material(spec["material"], **spec["material_overrides"]),
+                 n_tar=spec["n_tar"], n_pro=spec["n_pro"], v_col=v, b_off=float(np.sqrt(b2)),
+                 seed=seed, kind=spec["kind"], dim=spec["dim"], radius=spec["radius"],
+                 model=spec["model"], dt_over_tc=spec["dt"],
+                 dt_reason=f"dt = {spec['dt']:g} t_c, the campaign's")
+
+
+def claim(directory: Path):
+    """An open, locked ``directory/.claim``, or None if another process holds the run or
+    it has finished. Closing the file (or the holder's death) releases the claim."""
+    directory.mkdir(parents=True, exist_ok=True)
+    f = open(directory / ".claim", "a+")
+    try:
+        fcntl.lockf(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        f.close()
+        return None
+    if (directory / "outcome.json").exists():        # finished while we looked
+        f.close()
+        return None
+    f.truncate(0)
+    f.write(f"{socket.gethostname()} pid {os.getpid()} since {time.ctime()}\n")
+    f.flush()
+    return f
+
+
+#: restart files of a run, written alternately at every check (inputs/collision.lmp)
+RESTARTS = ("restart.a", "restart.b")
+
+
+def resume_point(directory: Path):
+    """(restart file, its step) to continue a cut-off run from, or None: the newer restart
+    file that LAMMPS reads whole (a file cut off while being written is passed over)."""
+    from .session import start_lammps
+
+    if not (directory / "collision.json").exists():
+        return None
+    found = sorted((p for p in (directory / name for name in RESTARTS) if p.exists()),
+                   key=lambda p: p.stat().st_mtime, reverse=True)
     from mpi4py import MPI
-    from tqdm import tqdm
 
-    from jkrdt.analysis.run import analyse_run
+    for path in found:
+        lmp = start_lammps(MPI.COMM_SELF)
+        try:
+            lmp.command(f"read_restart {path}")
+            return path, int(lmp.extract_global("ntimestep"))
+        except Exception:
+            continue
+        finally:
+            lmp.close()
+    return None
 
-    from .session import Session, write_scene_deck
 
-    comm = MPI.COMM_WORLD
+def cut_dump(path: Path, step: int) -> None:
+    """Keep the snapshots of a dump before ``step`` (the resumed run writes ``step`` again)."""
+    if not path.exists():
+        return
+    offset, end = 0, None
+    with path.open("rb") as f:
+        for line in f:
+            if line.startswith(b"ITEM: TIMESTEP"):
+                at = f.readline()
+                if int(at) >= step:
+                    end = offset
+                    break
+                offset += len(at)
+            offset += len(line)
+    if end is not None:
+        with path.open("r+b") as f:
+            f.truncate(end)
+
+
+def cut_log(path: Path, step: int) -> None:
+    """Keep a log up to its thermo row of ``step`` (the resumed run appends from there)."""
+    if not path.exists():
+        return
+    lines = path.read_text(errors="replace").splitlines(keepends=True)
+    last = 0
+    for k, line in enumerate(lines):
+        words = line.split()
+        if words and words[0].isdigit() and int(words[0]) <= step and len(words) > 3:
+            last = k + 1
+    path.write_text("".join(lines[:last]))
+
+
+def prepare(directory: Path, scene: Scene, aggregates: dict):
+    """Make ``directory`` ready to run (on the group's leader): "ended" if its run ended
+    and only its analysis is missing; (restart file, step) to resume from, the outputs
+    cut back to that step; or None after writing the scene afresh."""
+    from jkrdt.analysis.status import run_status
+
+    if (directory / "final.restart").exists() and (directory / "collision.json").exists():
+        status = run_status(directory)
+        if status.problem is None and status.stop_reason != "error":
+            return "ended"
+    point = resume_point(directory)
+    if point is not None:
+        for name in ("atoms.dump", "contacts.dump"):
+            cut_dump(directory / name, point[1])
+        cut_log(directory / "log.lammps", point[1])
+        return point
+    for name in scene_module.SCENE_FILES:
+        (directory / name).unlink(missing_ok=True)
+    if scene.seed not in aggregates:
+        aggregates[scene.seed] = scene.aggregates()
+    scene_module.write(directory, scene, scene.collide(aggregates[scene.seed]))
+    return None
+
+
+def run_one(spec: dict, directory: Path, resume, comm) -> str | None:
+    """Run one collision on ``comm``, from ``resume`` = (restart file, its step) if given;
+    returns None, or the LAMMPS error that ended it."""
+    from .session import Session
+
+    restart, start = resume if resume is not None else (None, 0)
+    remaining = None
+    if resume is not None and spec["settle"] is not None:      # the uninterrupted run's cap
+        ratio = scene_module.read(directory).time_step()[0]
+        remaining = dict(steps=spec["settle"].cap_steps(ratio) - start)
+    try:
+        with Session(directory, directory, every=spec["every"] or 1, comm=comm,
+                     settle=spec["settle"], restart=restart, append=resume is not None,
+                     variables=remaining) as run:
+            if spec["settle"] is None:
+                run.run(spec["steps"] - start, chunk=spec["every"], progress=False)
+            else:
+                run.run_until_settled(progress=False)
+            run.write_restart()
+    except Exception as err:            # a LAMMPS error: recorded, the campaign goes on
+        return str(err).strip().splitlines()[0]
+    return None
+
+
+def finish(directory: Path, seed, failed: str | None) -> str:
+    """Write the run's outcome.json, its analysis or its failure; returns a summary line."""
+    from jkrdt.analysis.run import analyse_run    # here: MDAnalysis slows every jkrdt start
+
+    if failed is None:
+        try:
+            out = analyse_run(directory)
+            return (f"{out['stop_reason']} at step {out['stop_step']}, N_lar {out['n_largest']}, "
+                    f"f_gro {out['growth_efficiency']:+.3f}")
+        except ValueError as err:        # the run's outputs do not add up: recorded
+            failed = f"analysis: {err}"
+    record_failure(directory, seed, failed)
+    return f"FAILED: {failed}"
+
+
+def run_campaign(spec_path, campaign, progress: bool = True, ranks_per_run: int = 1,
+                 comm=None) -> dict:
+    """Run every unfinished run of the campaign (see the module text); returns the number
+    of runs, those finished before it started ("skipped") and those it ran ("ran").
+    Under MPI the ranks of ``comm`` (default COMM_WORLD) run in groups of
+    ``ranks_per_run``; every rank returns the same counts."""
+    from mpi4py import MPI
+
+    world = comm if comm is not None else MPI.COMM_WORLD
     spec = read_spec(spec_path)
+    if not (isinstance(ranks_per_run, int) and 1 <= ranks_per_run <= world.size
+            and world.size % ranks_per_run == 0):
+        raise ValueError(f"--ranks-per-run {ranks_per_run} must divide the {world.size} "
+                         "MPI rank(s) into equal groups")
+    group = world.Split(color=world.rank // ranks_per_run, key=world.rank)
+    leader = group.rank == 0
     campaign = Path(campaign)
-    mat = material(spec["material"], **spec["material_overrides"])
-    s = scales(mat, spec["radius"])
     todo = plan(spec, campaign)
     skipped = sum((d / "outcome.json").exists() for *_, d in todo)
-    aggregates = {}
-    bar = tqdm(todo, unit="run", disable=not progress or comm.rank != 0)
-    for v, b2, seed, directory in bar:
-        if (directory / "outcome.json").exists():
+    world.Barrier()              # every rank has counted before any run finishes
+    aggregates, ran = {}, 0
+    for v, b2, seed, directory in todo:
+        held = None
+        if leader and not (directory / "outcome.json").exists():
+            held = claim(directory)
+        if not group.bcast(held is not None):
             continue
-        bar.set_description(f"v {v:g} B_off^2 {b2:g} seed {seed}")
-        if comm.rank == 0:
-            if seed not in aggregates:
-                rng = np.random.default_rng(seed)
-                build = BUILDERS[spec["kind"]]
-                aggregates[seed] = (build(spec["n_tar"], spec["radius"], s.delta0, rng,
-                                          dim=spec["dim"]),
-                                    build(spec["n_pro"], spec["radius"], s.delta0, rng,
-                                          dim=spec["dim"]))
-            tar, pro = aggregates[seed]
-            c = collision.set_up(tar, pro, spec["radius"], v_col=v, b_off=float(np.sqrt(b2)),
-                                 rng=np.random.default_rng([seed, 1]), material=mat,
-                                 dim=spec["dim"], seed=seed)
-            c.meta.update(kind=spec["kind"], model=spec["model"])
-            collision.write(c, mat, directory)
-            write_scene_deck(directory)
-        comm.Barrier()
-        failed = None
-        try:
-            with Session(directory, directory, dt=spec["dt"], every=spec["every"] or 1,
-                         comm=comm, settle=spec["settle"]) as run:
-                if spec["settle"] is None:
-                    run.run(spec["steps"], chunk=spec["every"], progress=False)
-                else:
-                    run.run_until_settled(progress=False)
-                run.write_restart()
-        except Exception as err:            # a LAMMPS error: recorded, the campaign goes on
-            failed = str(err).strip().splitlines()[0]
-        if comm.rank == 0:
-            if failed is None:
-                analyse_run(directory)
-            else:
-                record_failure(directory, v, b2, seed, failed)
-        comm.Barrier()
-    bar.close()
-    return dict(runs=len(todo), skipped=skipped, ran=len(todo) - skipped)
+        t0 = time.time()
+        resume = prepare(directory, scene_of(spec, v, b2, seed), aggregates) if leader \
+            else None
+        resume = group.bcast(resume)
+        failed = None if resume == "ended" else run_one(spec, directory, resume, group)
+        if leader:
+            said = finish(directory, seed, failed)
+            held.close()
+            ran += 1
+            how = ("" if resume is None else " (its run had ended; analysed)"
+                   if resume == "ended" else f" (resumed at step {resume[1]})")
+            if progress:
+                print(f"[ranks {world.rank}-{world.rank + group.size - 1}] v {v:g} B_off^2 "
+                      f"{b2:g} seed {seed}{how}: {said}, {time.time() - t0:.1f} s", flush=True)
+        group.Barrier()
+    group.Free()
+    ran = world.allreduce(ran if leader else 0)
+    return dict(runs=len(todo), skipped=skipped, ran=ran)

@@ -3,7 +3,7 @@
   jkrdt build   build one aggregate (BPCA or BCCA, 2D or 3D) and write it as a data file
   jkrdt setup   build target and projectile (BPCA or BCCA, 2D or 3D) and write a
                 collision: data file + collision.json (metadata)
-  jkrdt run     run a collision written by setup with inputs/collision.lmp
+  jkrdt run     run a collision written by setup with its own deck (DIR/in.collision.lmp)
   jkrdt analyse analyse a run directory: outcome per frame and at the end, tables, pictures
   jkrdt campaign run a grid of v_col x B_off^2 x seeds from a JSON spec (resumable)
   jkrdt summarise B_off-weighted campaign statistics (<f_gro>, v_fra, N_cum), tables, plots
@@ -23,12 +23,12 @@ from pathlib import Path
 import numpy as np
 
 from . import campaign as campaign_module
-from . import collision, timestep
-from .aggregates import bonds, gyration_radius
-from .campaign import BUILDERS
+from . import ledger, timestep
+from . import scene as scene_module
+from .aggregates import BUILDERS, bonds, gyration_radius
 from .datafile import write_sphere_data
 from .materials import PRESETS, material, scales
-from .session import find_deck, scene_variables, write_scene_deck
+from .scene import Scene
 from .stopping import DEFAULT_RULE, ENERGY_WARN, STOP_WORDS, SettleRule
 
 
@@ -98,81 +98,80 @@ def build(args) -> int:
     return 0
 
 
-#: the outputs a new run of a scene replaces; LAMMPS appends to none of them, but a run
-#: that fails early would leave the last run's behind
-RUN_OUTPUTS = ("atoms.dump", "contacts.dump", "log.lammps")
-#: what a scene directory holds once set up, run and analysed: all that --force clears
-SCENE_FILES = ("collision.data", "collision.json", "in.collision.lmp", *RUN_OUTPUTS,
-               "frames.csv", "outcome.json", "outcome.png", "outcome.pdf", "energy.png",
-               "energy.pdf", "restart.a", "restart.b", "final.restart", "final.dump")
-
-
-def write_scene(kind, n_tar, n_pro, radius, mat, v, b_off, seed, dim, model, out,
-                dt: float | str | None = None, tolerance: float = 1e-4, force: bool = False):
-    """Build target and projectile, set up their collision and write the scene into ``out``,
+def write_scene(scene: Scene, out, tolerance: float | None = None, force: bool = False):
+    """Build the scene's aggregates, set up their collision and write it into ``out``,
     which must be empty unless ``force`` (then the files of an earlier scene and its run
-    are removed, and nothing else). ``dt`` (t_c, or 'auto' for ``tolerance``) becomes the
-    scene's time step."""
+    are removed, and nothing else). With ``tolerance`` the time step is chosen for it
+    (``jkrdt.timestep.choose``) instead of the scene's."""
     out = Path(out)
     if out.is_dir() and any(out.iterdir()):
         if not force:
             raise SystemExit(f"jkrdt: {out} is not empty; choose another --out, or give --force "
                              "to replace the scene and run outputs there")
-        for name in SCENE_FILES:
+        for name in scene_module.SCENE_FILES:
             (out / name).unlink(missing_ok=True)
-    s = scales(mat, radius)
-    if dt == "auto":
+    if tolerance is not None:
         try:
-            dt, reason = timestep.choose(tolerance, v, s.v0)
+            dt, reason = timestep.choose(tolerance, scene.v_col, scene.scales.v0)
         except ValueError as err:
             raise SystemExit(f"jkrdt: {err}") from None
-    elif dt is not None:
-        reason = f"dt = {dt:g} t_c given to jkrdt setup"
-    rng = np.random.default_rng(seed)
-    build = BUILDERS[kind]
+        scene = dataclasses.replace(scene, dt_over_tc=dt, dt_reason=reason)
     t0 = time.time()
-    tar = build(n_tar, radius, s.delta0, rng, dim=dim)
-    pro = build(n_pro, radius, s.delta0, rng, dim=dim)
+    placed = scene.collide()
     built = time.time() - t0
-    c = collision.set_up(tar, pro, radius, v_col=v, b_off=b_off, rng=rng, material=mat,
-                         dim=dim, seed=seed)
-    c.meta.update(kind=kind, model=model, build_seconds=built)
-    if dt is not None:
-        c.meta.update(dt_over_tc=dt, dt_reason=reason)
-    data = collision.write(c, mat, out)
-    deck = write_scene_deck(out)
-    print(f"{kind.upper()} {n_tar} + {n_pro} ({dim}D, {mat.name}) built in {built:.1f} s; "
-          f"E_imp = {c.meta['E_imp']:.3e} J; wrote {data}, collision.json and {deck.name}"
-          + (f"\n{reason}" if dt is not None else ""))
+    scene_module.write(out, scene, placed, build_seconds=built)
+    print(f"{scene.kind.upper()} {scene.n_tar} + {scene.n_pro} ({scene.dim}D, "
+          f"{scene.material.name}, {scene.model}) built in {built:.1f} s; E_imp = "
+          f"{scene.E_imp:.3e} J; wrote {out / scene_module.DATA}, {scene_module.META} and "
+          f"{scene_module.DECK}\n{scene.time_step()[1]}")
+    return scene
 
 
-def run_scene(out: Path, model, dt: float | None, steps: int | None, nproc: int,
+def run_scene(out: Path, dt: float | None, steps: int | None, nproc: int,
               rule: SettleRule = DEFAULT_RULE) -> None:
-    """Run a scene written by ``write_scene`` with the deck, in its own directory: until
-    it settles by ``rule`` (the cap included), or ``steps`` steps when given."""
+    """Run the scene in ``out`` with its own deck, in its own directory: until it
+    settles by ``rule`` (the cap included), or ``steps`` steps when given; ``dt`` (t_c)
+    overrides the scene's time step."""
     from jkrdt.analysis.status import run_status
-    from jkrdt.analysis.thermo import energy_budget, energy_error, read_thermo
+    from jkrdt.analysis.thermo import read_thermo
 
-    variables = scene_variables(out, model, dt)
-    variables["out"] = out
-    dt = variables["dt_over_tc"]
+    scene = scene_module.read(out)
+    deck = out / scene_module.DECK
+    if not deck.exists():
+        raise SystemExit(f"jkrdt: {deck} does not exist: write the scene with 'jkrdt setup' "
+                         "(or jkrdt.scene.write_deck)")
+    variables = dict(out=".", **(scene.time_variables(dt) if dt is not None else {}))
+    ratio = scene.time_step(dt)[0]
     if steps is None:
-        variables.update(rule.deck_variables(dt))
+        variables.update(rule.deck_variables(ratio))
     else:
         variables.update(settle="no", steps=steps, every=output_interval(steps))
-    for stale in RUN_OUTPUTS:
+    for stale in scene_module.RUN_OUTPUTS:
         (out / stale).unlink(missing_ok=True)
     t0 = time.time()
-    run_lammps(find_deck(), out, variables, nproc=nproc)
+    run_lammps(deck, out, variables, nproc=nproc)
     status = run_status(out)
-    budget = energy_budget(read_thermo(out / "log.lammps"))
-    error = energy_error(budget, json.loads((out / "collision.json").read_text())["E_imp"])
-    print(f"{STOP_WORDS[status.stop_reason]} at step {status.stop_step} of at most {variables['steps']} "
-          f"({variables['model']}, dt = {dt:g} t_c) in {time.time() - t0:.1f} s on {nproc} "
-          f"rank(s); max |dE| / E_imp = {error:.2e}; log, dumps and restarts in {out}")
+    error = ledger.energy_error(ledger.energy_budget(read_thermo(out / "log.lammps")),
+                                scene.E_imp)
+    print(f"{STOP_WORDS[status.stop_reason]} at step {status.stop_step} of at most "
+          f"{variables['steps']} ({scene.model}, dt = {ratio:g} t_c) in {time.time() - t0:.1f} s "
+          f"on {nproc} rank(s); max |dE| / E_imp = {error:.2e}; log, dumps and restarts in {out}")
     if error > ENERGY_WARN:
         print(f"jkrdt: WARNING: max |dE| / E_imp = {error:.2e} exceeds {ENERGY_WARN:g}: reduce "
               "--dt (see 'Choosing the time step' in the README)", file=sys.stderr)
+
+
+def chosen_scene(args) -> Scene:
+    """The scene of ``jkrdt setup``'s options."""
+    try:
+        return Scene(material=chosen_material(args), n_tar=args.n_tar, n_pro=args.n_pro,
+                     v_col=args.v, b_off=args.b_off, seed=args.seed, kind=args.kind,
+                     dim=args.dim, radius=args.radius, model=args.model,
+                     dt_over_tc=None if args.dt in (None, "auto") else args.dt,
+                     dt_reason=None if args.dt in (None, "auto") else
+                     f"dt = {args.dt:g} t_c given to jkrdt setup")
+    except ValueError as err:
+        raise SystemExit(f"jkrdt: {err}") from None
 
 
 def setup(args) -> int:
@@ -180,9 +179,8 @@ def setup(args) -> int:
         raise SystemExit(f"jkrdt: --v is the collision speed and must be > 0 m/s (got {args.v})")
     if not 0 <= args.b_off <= 1:
         raise SystemExit(f"jkrdt: --b-off must lie in [0, 1] (got {args.b_off})")
-    write_scene(args.kind, args.n_tar, args.n_pro, args.radius, chosen_material(args), args.v,
-                args.b_off, args.seed, args.dim, args.model, args.out, dt=args.dt,
-                tolerance=args.tolerance, force=args.force)
+    write_scene(chosen_scene(args), args.out,
+                tolerance=args.tolerance if args.dt == "auto" else None, force=args.force)
     return 0
 
 
@@ -226,8 +224,7 @@ def run(args) -> int:
                          "scene); jkrdt run takes a number of t_c or the scene's dt")
     if args.steps is not None and args.steps < 1:
         raise SystemExit(f"jkrdt: --steps must be >= 1 (got {args.steps})")
-    run_scene(Path(args.dir).resolve(), args.model, args.dt, args.steps, args.np,
-              settle_rule(args))
+    run_scene(Path(args.dir).resolve(), args.dt, args.steps, args.np, settle_rule(args))
     return 0
 
 
@@ -235,9 +232,13 @@ def demo(args) -> int:
     from jkrdt.analysis.run import analyse_run, summary_text
 
     out = Path(args.out).resolve()
-    write_scene("bpca", args.n, args.n, 1.0e-7, material("ice"), args.v, args.b_off, args.seed,
-                3, args.model, out, force=True)    # the demo's directory is its own
-    run_scene(out, args.model, None, args.steps, args.np, settle_rule(args))
+    try:
+        scene = Scene(material=material("ice"), n_tar=args.n, n_pro=args.n, v_col=args.v,
+                      b_off=args.b_off, seed=args.seed, model=args.model)
+    except ValueError as err:
+        raise SystemExit(f"jkrdt: {err}") from None
+    write_scene(scene, out, force=True)    # the demo's directory is its own
+    run_scene(out, None, args.steps, args.np, settle_rule(args))
     print()
     print(summary_text(analyse_run(out)))
     print(f"tables                      {out / 'frames.csv'}, {out / 'outcome.json'}")
@@ -261,13 +262,20 @@ def analyse(args) -> int:
 def campaign(args) -> int:
     from .campaign import run_campaign
 
-    done = run_campaign(args.spec, args.dir, progress=not args.quiet)
-    print(f"{done['ran']} run(s) done, {done['skipped']} already finished, in {args.dir}")
+    from mpi4py import MPI
+
+    done = run_campaign(args.spec, args.dir, progress=not args.quiet,
+                        ranks_per_run=args.ranks_per_run)
+    if MPI.COMM_WORLD.rank == 0:
+        busy = done["runs"] - done["skipped"] - done["ran"]
+        print(f"{done['ran']} run(s) done, {done['skipped']} already finished"
+              + (f", {busy} run by another campaign at the same time" if busy > 0 else "")
+              + f", in {args.dir}")
     return 0
 
 
 def summarise(args) -> int:
-    from jkrdt.analysis.campaign import summarise as summarise_campaign
+    from jkrdt.analysis.summary import summarise as summarise_campaign
 
     try:
         summary = summarise_campaign(args.dir, plot=not args.no_plots,
@@ -333,7 +341,7 @@ def main(argv=None) -> int:
     d.add_argument("--b-off", type=float, default=0.3, help="impact parameter B_off")
     add_settle_options(d)
     d.add_argument("--np", type=int, default=1, help="MPI ranks")
-    d.add_argument("--model", choices=["frictional", "frictionless"], default="frictional",
+    d.add_argument("--model", choices=list(scene_module.MODELS), default="frictional",
                    help="Wada et al. (2007) with sliding, rolling, twisting (xi_crit = 8 A), "
                         "or the frictionless model of the 3D BPCA paper")
     d.add_argument("--seed", type=int, default=1)
@@ -346,7 +354,7 @@ def main(argv=None) -> int:
     st.add_argument("--v", type=float, default=20.0, help="collision speed, m/s")
     st.add_argument("--b-off", type=float, default=0.0, help="impact parameter B_off")
     add_material_options(st)
-    st.add_argument("--model", choices=["frictional", "frictionless"], default="frictional")
+    st.add_argument("--model", choices=list(scene_module.MODELS), default="frictional")
     st.add_argument("--seed", type=int, default=1)
     st.add_argument("--dt", type=time_step, default=None,
                     help="the scene's time step in units of t_c, or 'auto' to choose it from "
@@ -367,9 +375,8 @@ def main(argv=None) -> int:
     rn.add_argument("dir", help="directory with collision.data and collision.json")
     add_settle_options(rn)
     rn.add_argument("--dt", type=time_step, default=None,
-                    help="time step in units of t_c (default: the scene's, else 0.014)")
-    rn.add_argument("--model", choices=["frictional", "frictionless"], default=None,
-                    help="default: the model in collision.json")
+                    help="time step in units of t_c for this run (default: the scene's); the "
+                         "model is the scene's, set by jkrdt setup --model")
     rn.add_argument("--np", type=int, default=1, help="MPI ranks")
     an = sub.add_parser("analyse", help="outcome of a run directory: metrics per frame, "
                         "outcome.json, frames.csv, pictures")
@@ -385,7 +392,10 @@ def main(argv=None) -> int:
                         description=campaign_module.__doc__)
     cp.add_argument("spec", help="the campaign's JSON spec (keys above)")
     cp.add_argument("dir", help="where the runs go, one directory each")
-    cp.add_argument("--quiet", action="store_true")
+    cp.add_argument("--ranks-per-run", type=int, default=1,
+                    help="MPI ranks per collision under mpirun -np N: N / K collisions run "
+                         "side by side (default %(default)d)")
+    cp.add_argument("--quiet", action="store_true", help="no line per finished run")
     sm = sub.add_parser("summarise", help="B_off-weighted statistics of a campaign: "
                         "runs.csv, summary.csv, summary.json, plots")
     sm.add_argument("dir")

@@ -9,16 +9,12 @@ just outside contact.
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
-from pathlib import Path
 
 import numpy as np
 from scipy.spatial import cKDTree
 
 from .aggregates import gyration_radius, random_rotation
-from .datafile import write_sphere_data
-from .materials import Material, scales
 
 
 @dataclasses.dataclass
@@ -27,7 +23,7 @@ class Collision:
     v: np.ndarray          # (N, 3) velocities, m/s
     body: np.ndarray       # (N,) 1 = target, 2 = projectile
     radius: float
-    meta: dict
+    meta: dict             # the set-up's geometry: impact parameter b, initial gap (m)
 
 
 def characteristic_radius(x: np.ndarray) -> float:
@@ -36,18 +32,17 @@ def characteristic_radius(x: np.ndarray) -> float:
 
 
 def set_up(target: np.ndarray, projectile: np.ndarray, radius: float, v_col: float,
-           b_off: float, rng: np.random.Generator, material: Material, gap: float | None = None,
-           dim: int = 3, seed=None) -> Collision:
+           b_off: float, rng: np.random.Generator, delta_c: float, gap: float | None = None,
+           dim: int = 3) -> Collision:
     """Place ``projectile`` (N_pro, 3) to hit ``target`` (N_tar, 3) at ``v_col``.
 
     Both are rotated at random, centred on their centres of mass, and the
     projectile is slid along x until its nearest grain is ``gap`` (default
-    delta_c / 2) outside contact with the target.
+    delta_c / 2) outside contact with the target. ``jkrdt.scene`` writes the result.
     """
     if not 0.0 <= b_off <= 1.0:
         raise ValueError("B_off must lie in [0, 1]")
-    s = scales(material, radius)
-    gap = 0.5 * s.delta_c if gap is None else gap
+    gap = 0.5 * delta_c if gap is None else gap
     tar = target @ random_rotation(rng, dim).T
     pro = projectile @ random_rotation(rng, dim).T
     tar -= tar.mean(axis=0)
@@ -88,20 +83,5 @@ def set_up(target: np.ndarray, projectile: np.ndarray, radius: float, v_col: flo
     v[n_tar:, 0] = -v_col * n_tar / n_tot
     x -= x.mean(axis=0)
     body = np.r_[np.ones(n_tar, int), np.full(n_pro, 2)]
-    reduced = s.mass * n_tar * n_pro / n_tot
-    meta = dict(N_tar=n_tar, N_pro=n_pro, v_col=v_col, B_off=b_off, b=b, seed=seed,
-                material=dataclasses.asdict(material), radius=radius, dimension=dim,
-                E_imp=0.5 * reduced * v_col ** 2, gap=gap)
-    return Collision(x=x, v=v, body=body, radius=radius, meta=meta)
+    return Collision(x=x, v=v, body=body, radius=radius, meta=dict(b=b, gap=gap))
 
-
-def write(collision: Collision, material: Material, directory) -> Path:
-    """Write ``collision.data`` and ``collision.json`` (metadata) into ``directory``."""
-    directory = Path(directory)
-    directory.mkdir(parents=True, exist_ok=True)
-    write_sphere_data(directory / "collision.data", collision.x, collision.radius, material.density,
-                      v=collision.v, types=collision.body, margin=20 * collision.radius)
-    tmp = directory / "collision.json.tmp"
-    tmp.write_text(json.dumps(collision.meta, indent=2, default=float))
-    tmp.replace(directory / "collision.json")
-    return directory / "collision.data"

@@ -62,21 +62,6 @@ class Material:
     def shear_modulus(self) -> float:
         return self.G if self.G is not None else self.E / (2.0 * (1.0 + self.nu))
 
-    def pair_coeff(self, frictionless: bool = False) -> str:
-        """Keyword arguments of ``pair_coeff I J`` for this material, SI units."""
-        words = [f"gamma {self.gamma!r}", f"E {self.E!r}", f"nu {self.nu!r}"]
-        if self.G is not None:
-            words.append(f"G {self.G!r}")
-        if self.tvis > 0:
-            words.append(f"tvis {self.tvis!r}")
-        if frictionless:
-            words.append("frictionless")
-        elif self.xi_crit is None:
-            words.append("rolling off")
-        else:
-            words.append(f"xi_crit {self.xi_crit!r}")
-        return " ".join(words)
-
 
 ICE = Material("ice", gamma=0.100, E=7.0e9, nu=0.25, density=1000.0, xi_crit=8 * ANGSTROM)
 QUARTZ = Material("quartz", gamma=0.025, E=54.0e9, nu=0.17, density=2600.0, xi_crit=2 * ANGSTROM)

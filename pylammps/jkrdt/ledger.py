@@ -1,0 +1,59 @@
+"""The energy ledger: the layout of ``compute pair jkr/dt``'s vector, the thermo line that
+carries it, and the energy budget a run conserves.
+
+The plugin's compute gives 10 values (its manual page, "Output"):
+
+    1-4   U_n, U_s, U_r, U_t: the normal, sliding, rolling and twisting potentials
+    5-9   energy dissipated by contact formation and breaking ('events'), damping,
+          sliding, rolling and twisting: the channels of the ledger
+    10    the number of bonded contacts
+
+ke + erotate/sphere + pe + values 5-9 is conserved. This module is the one place that
+layout is written down: the deck's thermo line (``inputs/collision.lmp``, tested to
+match ``THERMO_STYLE``), ``Session``'s samples and the analysis of a log read it from here.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+#: the dissipation channels, in the order of values 5-9 of compute pair jkr/dt
+CHANNELS = ["events", "damping", "sliding", "rolling", "twisting"]
+#: 0-based index of the first channel and of the contact count in the compute's vector
+FIRST_CHANNEL, CONTACT_COUNT = 4, 9
+#: the compute's values as thermo names (the deck's compute is called p)
+LEDGER = [f"c_p[{FIRST_CHANNEL + 1 + k}]" for k in range(len(CHANNELS))]
+CONTACTS = f"c_p[{CONTACT_COUNT + 1}]"
+#: the deck's thermo keywords and the names LAMMPS gives their columns in a log
+THERMO_KEYWORDS = ["step", "time", "ke", "c_erot", "pe", *LEDGER, CONTACTS]
+THERMO = ["Step", "Time", "KinEng", "c_erot", "PotEng", *LEDGER, CONTACTS]
+THERMO_STYLE = "thermo_style    custom " + " ".join(THERMO_KEYWORDS)
+#: the conserved total as a LAMMPS equal-style formula over the deck's computes p, erot
+CONSERVED = "ke+c_erot+pe+" + "+".join(LEDGER)
+
+
+def sample(lmp) -> list[float]:
+    """The thermo columns (``THERMO``) at the current step of a LAMMPS instance running
+    the deck (a collective call under MPI)."""
+    p = lmp.numpy.extract_compute("p", 0, 1)
+    return [lmp.get_thermo("step"), lmp.get_thermo("time"), lmp.get_thermo("ke"),
+            float(lmp.extract_compute("erot", 0, 0)), lmp.get_thermo("pe"),
+            *(float(p[FIRST_CHANNEL + k]) for k in range(len(CHANNELS))),
+            float(p[CONTACT_COUNT])]
+
+
+def energy_budget(thermo: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """Kinetic (with rotation), potential, dissipated (in all and by channel) and total
+    energy over a run, from thermo columns named as in ``THERMO``."""
+    kinetic = thermo["KinEng"] + thermo["c_erot"]
+    dissipated = sum(thermo[c] for c in LEDGER)
+    budget = dict(kinetic=kinetic, potential=thermo["PotEng"], dissipated=dissipated,
+                  total=kinetic + thermo["PotEng"] + dissipated)
+    budget.update({name: thermo[c] for name, c in zip(CHANNELS, LEDGER)})
+    return budget
+
+
+def energy_error(budget: dict[str, np.ndarray], e_imp: float) -> float:
+    """max |dE| / E_imp over a run, dE the change of the conserved total."""
+    total = budget["total"]
+    return float(np.abs(total - total[0]).max() / e_imp)

@@ -1,0 +1,115 @@
+"""The scene contract: one module writes a scene directory and reads it back, turns a
+material and a model into the pair_coeff line, and every route runs the scene's own deck."""
+
+import ast
+import dataclasses
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from jkrdt import ledger
+from jkrdt import scene as scene_module
+from jkrdt.materials import ICE, QUARTZ, material
+from jkrdt.scene import Scene, pair_coeff
+
+ROOT = Path(__file__).resolve().parents[1]
+BIN = Path(sys.executable).parent
+
+
+def test_pair_coeff_is_one_translation_of_material_and_model():
+    assert pair_coeff(ICE) == "gamma 0.1 E 7000000000.0 nu 0.25 xi_crit 8e-10"
+    assert pair_coeff(ICE, "frictionless") == "gamma 0.1 E 7000000000.0 nu 0.25 frictionless"
+    damped = dataclasses.replace(QUARTZ, G=2e10, tvis=6e-12)
+    assert pair_coeff(damped) == ("gamma 0.025 E 54000000000.0 nu 0.17 G 20000000000.0 "
+                                  "tvis 6e-12 xi_crit 2e-10")
+    with pytest.raises(ValueError, match="has no xi_crit: give one, or use the 'frictionless'"):
+        pair_coeff(material("ice", xi_crit=None))
+    with pytest.raises(ValueError, match="unknown model 'sticky'"):
+        pair_coeff(ICE, "sticky")
+    with pytest.raises(ValueError, match="has no xi_crit"):       # a scene is checked at once
+        Scene(material("ice", xi_crit=None), 8, 8, v_col=1.0)
+
+
+def test_a_written_scene_reads_back_and_holds_its_impact_energy(tmp_path):
+    scene = Scene(ICE, 40, 24, v_col=25.0, b_off=0.4, seed=3, dim=3, model="frictionless",
+                  dt_over_tc=0.01, dt_reason="a test's dt")
+    scene_module.write(tmp_path, scene)
+    back = scene_module.read(tmp_path)
+    assert back == scene
+    # E_imp = mu v^2 / 2 is the kinetic energy of the data file's velocities (CM frame)
+    rows = (tmp_path / scene_module.DATA).read_text().split("Velocities")[1].split()
+    v = np.array(rows, dtype=float).reshape(-1, 7)[:, 1:4]
+    s = scene.scales
+    assert 0.5 * s.mass * (v ** 2).sum() == pytest.approx(scene.E_imp, rel=1e-12)
+    assert np.abs(v.sum(axis=0)).max() < 1e-12 * 25.0
+    deck = (tmp_path / scene_module.DECK).read_text()
+    assert f'variable coeffs     index "{pair_coeff(ICE, "frictionless")}"' in deck
+    assert f'variable dt         index "{0.01 * s.t_c!r}"' in deck
+    assert deck.endswith(scene_module.find_template().read_text())
+
+
+def test_committed_scene_decks_are_what_the_scene_module_writes(tmp_path):
+    for name in ("bcca_2d_head_on", "bpca_3d_oblique"):
+        committed = ROOT / "inputs" / "data" / name
+        copy = tmp_path / name
+        copy.mkdir()
+        (copy / scene_module.META).write_text((committed / scene_module.META).read_text())
+        scene_module.write_deck(copy)
+        assert (copy / scene_module.DECK).read_text() == \
+            (committed / scene_module.DECK).read_text(), \
+            f"regenerate with jkrdt.scene.write_deck('inputs/data/{name}')"
+
+
+def test_the_template_carries_the_ledger_and_refuses_to_run_without_a_scene(tmp_path):
+    template = scene_module.find_template().read_text()
+    assert ledger.THERMO_STYLE in template.splitlines()
+    done = subprocess.run([str(BIN / "lmp"), "-in", str(ROOT / "inputs" / "collision.lmp"),
+                           "-log", "none"], capture_output=True, text=True, cwd=tmp_path)
+    said = [line for line in done.stdout.splitlines() if line.startswith("ERROR")]
+    assert done.returncode != 0 and said == [
+        "ERROR: inputs/collision.lmp runs a scene: give -var coeffs and -var dt, or run the "
+        "in.collision.lmp that jkrdt setup wrote into the scene directory"]
+
+
+def test_jkrdt_run_runs_the_scenes_own_deck(tmp_path):
+    scene = Scene(ICE, 8, 8, v_col=5.0, seed=2, model="frictional")
+    scene_module.write(tmp_path, scene)
+    deck = tmp_path / scene_module.DECK
+    # an edit to the scene's deck is what runs: here its pair_coeff words
+    deck.write_text(deck.read_text().replace(pair_coeff(ICE), pair_coeff(ICE, "frictionless")))
+    subprocess.run([str(BIN / "jkrdt"), "run", str(tmp_path), "--steps", "200"], check=True,
+                   capture_output=True)
+    log = (tmp_path / "log.lammps").read_text()
+    assert f"pair_coeff      * * {pair_coeff(ICE, 'frictionless')}" in log
+
+
+CORE = ["aggregates", "collision", "datafile", "ledger", "materials", "plugin", "scene",
+        "session", "stopping", "timestep"]
+
+
+def imported(path: Path) -> set[str]:
+    """Every module ``path`` imports, at any depth of its code, relative ones resolved."""
+    names = set()
+    package = "jkrdt" if path.parent.name == "jkrdt" else "jkrdt.analysis"
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            names |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom):
+            base = package.rsplit(".", node.level - 1)[0] if node.level else ""
+            module = ".".join(p for p in (base, node.module or "") if p)
+            names |= {module} | {f"{module}.{a.name}" for a in node.names}
+    return names
+
+
+def test_the_packages_depend_one_way():
+    # core -> (nothing of ours above it); analysis -> core; cli, campaign -> both
+    for name in CORE:
+        uses = imported(ROOT / "pylammps" / "jkrdt" / f"{name}.py")
+        assert not {u for u in uses if u.startswith("jkrdt.analysis")}, name
+        assert not uses & {"jkrdt.cli", "jkrdt.campaign"}, name
+    for path in (ROOT / "analysis").glob("*.py"):
+        uses = imported(path)
+        assert not uses & {"jkrdt.cli", "jkrdt.campaign", "jkrdt.session"}, path.name
