@@ -3,8 +3,10 @@
     N_lar, N_second   sizes of the largest and second-largest fragment
     f_gro             growth efficiency (N_lar - N_tar) / N_pro   (3D BPCA paper, sec. 3.1)
     r_g               gyration radius of the largest fragment     (Wada et al. 2007, eq. 50)
-    n_con             contacts per grain in the largest fragment, 2 n_contacts / N_lar
-                      (Wada et al. 2007, sec. 5.3, Fig. 11)
+    n_con             contacts per grain in the largest fragment, n_contacts / N_lar: about 1
+                      for an aggregate that is a tree (N - 1 contacts), more once compressed
+                      (Wada et al. 2007, sec. 5.3, Fig. 11, eqs. 56-57; half the mean
+                      coordination number)
     n_fragments       number of fragments
     N_cum(<= N)       grains in fragments of at most N grains     (3D BPCA paper, sec. 3.2)
 
@@ -58,7 +60,7 @@ def measure(x: np.ndarray, labels: np.ndarray, pairs: np.ndarray, n_target: int,
         n_fragments=len(sizes),
         growth_efficiency=(n_lar - n_target) / n_projectile,
         gyration_radius_largest=gyration_radius(x[largest]),
-        contacts_per_particle=2.0 * int(inside.sum()) / n_lar)
+        contacts_per_particle=int(inside.sum()) / n_lar)
 
 
 def measure_frame(frame, n_target: int, n_projectile: int, tolerance: float | None = None):

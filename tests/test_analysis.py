@@ -35,7 +35,7 @@ def test_two_separate_aggregates():
     out = measure(x, by_positions, pairs, 40, 25)
     assert (out.n_largest, out.n_second, out.n_fragments) == (40, 25, 2)
     assert out.growth_efficiency == 0.0                       # (N_lar - N_tar) / N_pro
-    assert out.contacts_per_particle == pytest.approx(2 * 39 / 40)   # a tree: N - 1 bonds
+    assert out.contacts_per_particle == pytest.approx(39 / 40)   # a tree: N - 1 bonds
     assert out.gyration_radius_largest == pytest.approx(gyration_radius(a), rel=1e-12)
     n, n_cum = frag.cumulative_number(by_positions)
     assert n.tolist() == [25, 40] and n_cum.tolist() == [25, 65]
@@ -50,7 +50,7 @@ def test_chain_breaks_beyond_delta_c(extra, expected):
     out = measure(x, labels, frag.position_pairs(x, R, S.delta_c), 7, 3)
     assert out.n_largest == expected[0]
     assert out.growth_efficiency == pytest.approx((expected[0] - 7) / 3)
-    assert out.contacts_per_particle == pytest.approx(2 * (expected[0] - 1) / expected[0])
+    assert out.contacts_per_particle == pytest.approx((expected[0] - 1) / expected[0])
 
 
 def test_contact_list_overrides_geometry():

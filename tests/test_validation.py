@@ -1,0 +1,66 @@
+"""The quick variant of validation/wada2007_2d.py: 2D BCCA head-on collisions of 2 x 32
+grains (quartz and ice, xi_crit = 2 A, 5 speeds, 2 seeds) against Wada et al. (2007)."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from jkrdt.analysis.tables import read_csv
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def quick(tmp_path_factory):
+    d = tmp_path_factory.mktemp("validation")
+    subprocess.run([sys.executable, str(ROOT / "validation" / "wada2007_2d.py"), "--quick",
+                    "--runs", str(d / "runs"), "--results", str(d / "results")], check=True,
+                   timeout=900, capture_output=True)
+    return json.loads((d / "results" / "summary.json").read_text()), \
+        read_csv(d / "results" / "runs.csv"), d / "results"
+
+
+def test_every_run_settles_within_the_energy_budget(quick):
+    summary, rows, results = quick
+    assert summary["stop_reasons"] == {"settled": 20}
+    # dt = 0.014 t_c up to 20 v0: the tradeoff fit puts the worst run near 1e-4 E_imp
+    assert max(r["energy_error"] for r in rows) < 1e-3
+    for stem in ("fig7_gyration", "fig11_contacts", "fig14_largest", "fig6_shares"):
+        assert (results / f"{stem}.png").stat().st_size > 0
+
+
+def test_gyration_radius_follows_eq_51(quick):
+    eq51 = quick[0]["eq51"]
+    # the paper's Fig. 7a scatters by about +-15 % about eq. (51) over its fit range (three
+    # structures); at N_total = 64 instead of 256 the BCCAs are denser (Fig. 8), so the
+    # mean ratio is held to 20 % and the slope to 0.05 of the paper's -0.12
+    assert eq51["fit"]["points"] >= 5
+    assert abs(eq51["ratio_mean"] - 1) < 0.2
+    assert abs(eq51["fit"]["b"] + 0.12) < 0.05
+
+
+def test_contacts_grow_as_eq_56(quick):
+    eq56 = quick[0]["eq56"]
+    # the slope is the paper's to 0.1; the prefactor lies below 1 at N_total = 64, where
+    # edge grains (contacts 1) are a larger share (sec. 5.3, Fig. 12): within a factor 1.6
+    assert abs(eq56["fit"]["b"] - 0.75) < 0.1
+    assert 1 / 1.6 < eq56["ratio_mean"] < 1.6
+
+
+def test_ice_compacts_further_than_quartz(quick):
+    sets = quick[0]["sets"]
+    # eq. (57): k = 1.6 for ice against 1.3-1.4 for quartz; E_roll / E_break 1.94 vs 18.6
+    assert sets["ice 2A"]["n_con_max"] > sets["quartz 2A"]["n_con_max"] + 0.1
+    assert sets["ice 2A"]["n_con_max"] == pytest.approx(sets["ice 2A"]["eq57"][0], abs=0.1)
+
+
+def test_disruption_is_scaled_by_n_k_E_break(quick):
+    sets = quick[0]["sets"]
+    # the paper: grains are lost from ~3 n_k E_break, catastrophic above ~10 (Fig. 14);
+    # smaller aggregates disrupt more easily (Fig. 15a): a factor 3 either way at N = 64
+    for name in ("ice 2A", "quartz 2A"):
+        assert 1.0 < sets[name]["disruption_starts_at_y"] < 9.0, name
+        assert 10 / 3 < sets[name]["catastrophic_at_y"] < 30, name

@@ -1,0 +1,42 @@
+"""What the validation studies share: running their campaigns and saving their figures."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+BIN = Path(sys.executable).parent
+
+
+def run_campaigns(specs: dict[str, dict], runs: Path, ranks: int) -> dict[str, Path]:
+    """Run one ``jkrdt campaign`` per spec (``runs/<name>``), each over ``ranks`` MPI ranks
+    in groups of one; a second call resumes them. Returns the campaign directories."""
+    runs.mkdir(parents=True, exist_ok=True)
+    where = {}
+    for name, spec in specs.items():
+        slug = name.replace(" ", "_").replace("+", "_")
+        where[name] = runs / slug
+        path = runs / f"{slug}.json"
+        path.write_text(json.dumps(spec))
+        cmd = [str(BIN / "jkrdt"), "campaign", str(path), str(where[name]), "--quiet"]
+        if ranks > 1:
+            cmd = [str(BIN / "mpirun"), "-np", str(ranks)] + cmd
+        t0 = time.time()
+        subprocess.run(cmd, check=True)
+        print(f"{name}: campaign done in {time.time() - t0:.0f} s", flush=True)
+    return where
+
+
+def save(fig, results: Path, stem: str) -> list[Path]:
+    """``fig`` as results/stem.png and .pdf."""
+    import matplotlib.pyplot as plt
+
+    out = []
+    for suffix in (".png", ".pdf"):
+        fig.savefig(results / f"{stem}{suffix}", dpi=120)
+        out.append(results / f"{stem}{suffix}")
+    plt.close(fig)
+    return out
