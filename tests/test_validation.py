@@ -1,5 +1,7 @@
-"""The quick variant of validation/wada2007_2d.py: 2D BCCA head-on collisions of 2 x 32
-grains (quartz and ice, xi_crit = 2 A, 5 speeds, 2 seeds) against Wada et al. (2007)."""
+"""The quick variants of the validation studies: validation/wada2007_2d.py (2D BCCA
+head-on collisions of 2 x 32 grains, quartz and ice, xi_crit = 2 A, 5 speeds, 2 seeds,
+against Wada et al. 2007) and validation/bpca3d_models.py (the 3D BPCA paper's four
+models at 2 x 24 grains)."""
 
 import json
 import subprocess
@@ -64,3 +66,32 @@ def test_disruption_is_scaled_by_n_k_E_break(quick):
     for name in ("ice 2A", "quartz 2A"):
         assert 1.0 < sets[name]["disruption_starts_at_y"] < 9.0, name
         assert 10 / 3 < sets[name]["catastrophic_at_y"] < 30, name
+
+
+@pytest.fixture(scope="module")
+def models(tmp_path_factory):
+    d = tmp_path_factory.mktemp("models")
+    subprocess.run([sys.executable, str(ROOT / "validation" / "bpca3d_models.py"), "--quick",
+                    "--runs", str(d / "runs"), "--results", str(d / "results")], check=True,
+                   timeout=900, capture_output=True)
+    return json.loads((d / "results" / "summary.json").read_text())
+
+
+def test_the_four_models_keep_the_papers_order(models):
+    """The quick variant of validation/bpca3d_models.py (2 x 24 ice BPCAs, 10, 39.8 and
+    100 m/s, B_off^2 0 and 1/2): the 3D BPCA paper's ordering of the models."""
+    at = models["24"]
+    assert all(reasons == {"settled": 6} for reasons in at["stop_reasons"].values())
+    assert at["energy_error_max"] < 1e-3
+    curves = models["curves"]["24"]
+    # Fig. 2: without friction the aggregates grow less at every speed, and v_fra is lowest
+    for free, fric in zip(curves["frictionless"]["mean_f_gro"],
+                          curves["frictional"]["mean_f_gro"]):
+        assert free <= fric
+    assert at["lowest_v_fra"] == "frictionless"
+    assert at["v_fra"]["frictionless"] < at["v_fra"]["frictional"]
+    # Fig. 3 at 39.8 m/s: frictionless grains without damping end in small fragments far
+    # more often than with friction or with damping
+    small = at["grains_in_fragments_of_at_most_16"]["39.8"]
+    assert small["frictionless"] > 2 * small["frictional"]
+    assert small["frictionless"] > 2 * small["frictionless, T_vis 6 ps"]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 import time
@@ -17,7 +18,7 @@ def run_campaigns(specs: dict[str, dict], runs: Path, ranks: int) -> dict[str, P
     runs.mkdir(parents=True, exist_ok=True)
     where = {}
     for name, spec in specs.items():
-        slug = name.replace(" ", "_").replace("+", "_")
+        slug = re.sub(r"[^A-Za-z0-9.]+", "_", name)
         where[name] = runs / slug
         path = runs / f"{slug}.json"
         path.write_text(json.dumps(spec))
