@@ -15,14 +15,19 @@ from jkrdt.analysis.tables import read_csv
 ROOT = Path(__file__).resolve().parents[1]
 
 
+def run_quick(study: str, where: Path) -> Path:
+    """``validation/<study>.py --quick`` with its runs and results below ``where``."""
+    subprocess.run([sys.executable, str(ROOT / "validation" / f"{study}.py"), "--quick",
+                    "--runs", str(where / "runs"), "--results", str(where / "results")],
+                   check=True, timeout=900, capture_output=True)
+    return where / "results"
+
+
 @pytest.fixture(scope="module")
 def quick(tmp_path_factory):
-    d = tmp_path_factory.mktemp("validation")
-    subprocess.run([sys.executable, str(ROOT / "validation" / "wada2007_2d.py"), "--quick",
-                    "--runs", str(d / "runs"), "--results", str(d / "results")], check=True,
-                   timeout=900, capture_output=True)
-    return json.loads((d / "results" / "summary.json").read_text()), \
-        read_csv(d / "results" / "runs.csv"), d / "results"
+    results = run_quick("wada2007_2d", tmp_path_factory.mktemp("validation"))
+    return json.loads((results / "summary.json").read_text()), \
+        read_csv(results / "runs.csv"), results
 
 
 def test_every_run_settles_within_the_energy_budget(quick):
@@ -70,11 +75,8 @@ def test_disruption_is_scaled_by_n_k_E_break(quick):
 
 @pytest.fixture(scope="module")
 def models(tmp_path_factory):
-    d = tmp_path_factory.mktemp("models")
-    subprocess.run([sys.executable, str(ROOT / "validation" / "bpca3d_models.py"), "--quick",
-                    "--runs", str(d / "runs"), "--results", str(d / "results")], check=True,
-                   timeout=900, capture_output=True)
-    return json.loads((d / "results" / "summary.json").read_text())
+    results = run_quick("bpca3d_models", tmp_path_factory.mktemp("models"))
+    return json.loads((results / "summary.json").read_text())
 
 
 def test_the_four_models_keep_the_papers_order(models):

@@ -194,14 +194,14 @@ RESTARTS = ("restart.a", "restart.b")
 def resume_point(directory: Path):
     """(restart file, its step) to continue a cut-off run from, or None: the newer restart
     file that LAMMPS reads whole (a file cut off while being written is passed over)."""
+    from mpi4py import MPI
+
     from .session import start_lammps
 
     if not (directory / "collision.json").exists():
         return None
     found = sorted((p for p in (directory / name for name in RESTARTS) if p.exists()),
                    key=lambda p: p.stat().st_mtime, reverse=True)
-    from mpi4py import MPI
-
     for path in found:
         lmp = start_lammps(MPI.COMM_SELF)
         try:
