@@ -114,7 +114,7 @@ def outcome(path, start: np.ndarray, end: np.ndarray, body: np.ndarray, labels: 
     for row, (i, j) in enumerate(views):
         a, e = axes[row]
         d = _frame_axes(a, start, i, j, radius, names)
-        _discs(a, start, i, j, d, [BODY_COLOURS[k] for k in body])
+        _discs(a, start, i, j, d, [BODY_COLOURS.get(k, "0.6") for k in body])
         if j == 1:                      # the impact direction and the offset, in x-y
             c_tar, c_pro = start[tar].mean(axis=0) * 1e6, start[pro].mean(axis=0) * 1e6
             span = np.ptp(start[:, 0]) * 1e6
