@@ -90,6 +90,7 @@ def outcome(path, start: np.ndarray, end: np.ndarray, body: np.ndarray, labels: 
     projectile in a lighter shade of it) and the others are faint.
     ``when`` = ((step, time in s) of the start, (step, time) of the end)."""
     plt = _pyplot()
+    from matplotlib.colors import to_rgb
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
@@ -102,7 +103,6 @@ def outcome(path, start: np.ndarray, end: np.ndarray, body: np.ndarray, labels: 
     rank[np.argsort(sizes, kind="stable")[::-1]] = np.arange(len(sizes))
     grain_rank = rank[labels]
     big = grain_rank < len(FRAGMENT_COLOURS)
-    from matplotlib.colors import to_rgb
 
     def shade(r, k):           # the fragment's colour; lighter for grains of the projectile
         rgb = np.array(to_rgb(FRAGMENT_COLOURS[r] if r < len(FRAGMENT_COLOURS) else "0.7"))

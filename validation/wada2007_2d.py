@@ -225,6 +225,12 @@ def figures(plan: dict, rows: list[dict], results: Path) -> list[Path]:
         if ylog:
             ax.set_yscale("log")
 
+    def label(ax, x, y, heading):
+        ax.set_xlabel(x)
+        ax.set_ylabel(y)
+        ax.set_title(heading, fontsize=9)
+        ax.legend(fontsize=7)
+
     def save(fig, stem):
         saved.extend(save_figure(fig, results, stem))
 
@@ -235,10 +241,8 @@ def figures(plan: dict, rows: list[dict], results: Path) -> list[Path]:
     ax.plot(e, eq51(e), "0.4", lw=2, label="eq. (51), its fit range")
     e = np.geomspace(min(r["x"] for r in good), max(r["x"] for r in good), 40)
     ax.plot(e, eq51(e), "0.7", lw=1, ls="--")
-    ax.set_xlabel("E_imp / (n_k E_roll)")
-    ax.set_ylabel("r_g / (r_1 N_large^1/2)")
-    ax.set_title("Wada et al. (2007) Fig. 7a\n" + title, fontsize=9)
-    ax.legend(fontsize=7)
+    label(ax, "E_imp / (n_k E_roll)", "r_g / (r_1 N_large^1/2)",
+          "Wada et al. (2007) Fig. 7a\n" + title)
     save(fig, "fig7_gyration")
 
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.6), constrained_layout=True)
@@ -248,17 +252,12 @@ def figures(plan: dict, rows: list[dict], results: Path) -> list[Path]:
             k_lo, k_hi = K_EQ57[SETS[name][0]]
             a.axhspan(eq57(k_lo, n_total), eq57(k_hi, n_total) + 0.004,
                       color=marks[name][1], alpha=0.2, label=f"eq. (57), {SETS[name][0]}")
-    a.set_xlabel("E_imp / (n_k E_roll)")
-    a.set_ylabel("n_con (largest cluster)")
-    a.set_title("Fig. 11a, with eq. (57) for xi_crit = 2 A", fontsize=9)
-    a.legend(fontsize=7)
+    label(a, "E_imp / (n_k E_roll)", "n_con (largest cluster)",
+          "Fig. 11a, with eq. (57) for xi_crit = 2 A")
     points(b, ("x", "n_con"), shift=1.0)
     e = np.geomspace(1.0 / (n_total - 2), 0.1, 20)
     b.plot(e, eq56(e), "0.4", lw=2, label="eq. (56), its range")
-    b.set_xlabel("E_imp / (n_k E_roll)")
-    b.set_ylabel("n_con - 1")
-    b.set_title("Fig. 11b\n" + title, fontsize=9)
-    b.legend(fontsize=7)
+    label(b, "E_imp / (n_k E_roll)", "n_con - 1", "Fig. 11b\n" + title)
     save(fig, "fig11_contacts")
 
     fig, ax = plt.subplots(figsize=(6.5, 4.8), constrained_layout=True)
@@ -268,10 +267,7 @@ def figures(plan: dict, rows: list[dict], results: Path) -> list[Path]:
         ax.text(mark * 1.05, 0.05, text, rotation=90, fontsize=8)
     ax.axhline(0.5, color="0.7", lw=0.8)
     ax.set_ylim(0, 1.05)
-    ax.set_xlabel("E_imp / (n_k E_break)")
-    ax.set_ylabel("N_large / N_total")
-    ax.set_title("Fig. 14\n" + title, fontsize=9)
-    ax.legend(fontsize=7)
+    label(ax, "E_imp / (n_k E_break)", "N_large / N_total", "Fig. 14\n" + title)
     save(fig, "fig14_largest")
 
     fig, axes = plt.subplots(1, len(plan["sets"]), figsize=(3.4 * len(plan["sets"]), 3.8),

@@ -136,10 +136,7 @@ def run_scene(out: Path, dt: float | None, steps: int | None, nproc: int,
     from jkrdt.analysis.thermo import read_thermo
 
     scene = scene_module.read(out)
-    deck = out / scene_module.DECK
-    if not deck.exists():
-        raise SystemExit(f"jkrdt: {deck} does not exist: write the scene with 'jkrdt setup' "
-                         "(or jkrdt.scene.write_deck)")
+    deck = scene_module.deck(out)
     variables = dict(out=".", **(scene.time_variables(dt) if dt is not None else {}))
     ratio = scene.time_step(dt)[0]
     if steps is None:

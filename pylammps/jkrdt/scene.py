@@ -200,6 +200,15 @@ def find_template(name: str = "collision.lmp") -> Path:
                             "or run from the repository root")
 
 
+def deck(directory) -> Path:
+    """The scene's own deck in ``directory``; raises with the fix if it is missing."""
+    path = Path(directory) / DECK
+    if not path.exists():
+        raise FileNotFoundError(f"{path} does not exist: write the scene with 'jkrdt setup', "
+                                f"or its deck with jkrdt.scene.write_deck('{directory}')")
+    return path
+
+
 def write_deck(directory, scene: Scene | None = None) -> Path:
     """``in.collision.lmp``: the scene's variables, then ``inputs/collision.lmp`` verbatim
     (a variable's first definition wins, so ``-var NAME VALUE`` still overrides)."""

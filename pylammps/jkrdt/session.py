@@ -106,10 +106,7 @@ class Session:
         self.comm.Barrier()
         self.meta = scene_module.read_metadata(scene)
         self.scene = scene_module.from_metadata(self.meta)
-        deck = scene / scene_module.DECK
-        if not deck.exists():
-            raise FileNotFoundError(f"{deck} does not exist: write the scene's deck with "
-                                    f"jkrdt.scene.write_deck('{scene}')")
+        deck = scene_module.deck(scene)
         self.settle = settle
         self.stop_reason: str | None = None
         chosen = dict(file=scene / scene_module.DATA, out=self.out, every=every or 1000,
