@@ -22,8 +22,9 @@
         (eqs. 42, A8); the loads of eqs. (14), (17), (23), (27) follow from
         the clamped state
    A contact that forms gets n1 = -n_c, n2 = n_c, phi = 0. The force
-   evaluation of a run's set-up (setup = true) moves nothing and books
-   nothing, so that a continued run equals an uninterrupted one.
+   evaluation of a run's set-up (setup = true) moves nothing, clamps nothing
+   and books nothing, so that a run continued from a restart file equals the
+   uninterrupted one bit for bit.
 
    Energy: a step that clamps or breaks books, per channel, the difference
    between the work the loads did (trapezoid over the step, which is what
@@ -195,8 +196,14 @@ inline void tangential_step(const ContactConstants &c, const StateLayout &L,
   if (breaking) {
     for (int ch = 0; ch < NCHANNEL; ch++) load[ch] = {0.0, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
   } else {
+    // a set-up evaluates the stored state as it is: the clamp of eqs. (42), (A8) is exact
+    // to second order only, so clamping again would move a contact the last step left on
+    // its plateau, and a run continued from a restart file would leave the uninterrupted one
     Displacements d;                                                     // eqs. (8)-(20)
-    clamped = clamp_to_elastic_limits(now, nc, c.r1, c.r2, R, K, d);    // eqs. (42), (A8)
+    if (setup)
+      d = displacements(now, nc, c.r1, c.r2, R);
+    else
+      clamped = clamp_to_elastic_limits(now, nc, c.r1, c.r2, R, K, d);
     tangential_load(now, d, nc, m.r, c.r1, c.r2, R, K, load);           // eqs. (14)-(27)
   }
 

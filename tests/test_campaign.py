@@ -170,12 +170,12 @@ def test_a_killed_campaign_resumes_from_its_restart_file(tmp_path):
     assert log.count("Reading restart file") == 1     # continued, not started again
     whole = json.loads(next((tmp_path / "whole").rglob("outcome.json")).read_text())
     again = json.loads((run / "outcome.json").read_text())
-    # the continuation is the uninterrupted run: same stop, same outcome, same ledger
-    for key in ("stop_reason", "stop_step", "n_largest", "n_fragments", "contacts_per_particle"):
+    # the continuation is the uninterrupted run bit for bit, wherever the kill fell
+    # (test_invariance.py checks every restart point of a run): same stop, outcome, ledger
+    for key in ("stop_reason", "stop_step", "n_largest", "n_fragments", "contacts_per_particle",
+                "gyration_radius_largest", "dissipated_fraction", "dissipated_by_channel",
+                "energy_error"):
         assert again[key] == whole[key], key
-    assert again["gyration_radius_largest"] == pytest.approx(whole["gyration_radius_largest"],
-                                                              rel=1e-12)
-    assert again["dissipated_fraction"] == pytest.approx(whole["dissipated_fraction"], rel=1e-9)
     frames = [r["step"] for r in read_csv(run / "frames.csv")]
     assert frames == [r["step"] for r in read_csv(whole["run"] + "/frames.csv")]
 

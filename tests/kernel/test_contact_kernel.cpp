@@ -6,6 +6,7 @@
 
 #include "jkr_dt_contact.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -138,6 +139,39 @@ static void clamps()
   }
 }
 
+// a run's set-up (setup = true) evaluates the stored state and changes nothing: a contact
+// the last step left on its plateaus (sliding and rolling both clamped, so the second-order
+// residual of eq. (42) is there) keeps its pointers bit for bit and gets the step's loads
+// again, which is what makes a run continued from a restart file the uninterrupted run
+static void setup_changes_nothing()
+{
+  const ContactConstants c = contact_constants(ice(true, true, true), R_GRAIN, R_GRAIN);
+  const double delta = c.S.delta0;
+  const ContactMotion m = at_rest(delta);
+  const double ts = 0.55 * c.K.zeta_crit / R_GRAIN, tr = 0.55 * XI_CRIT / c.S.R;    // 1.15x
+  const double t1 = tr + ts, t2 = tr - ts;
+  double s[7] = {-1.0, t1, 0.3 * t1, 1.0, t2, 0.3 * t2, 2.0 * PHI_CRIT};
+  for (int k = 0; k < 3; k++) s[k] /= std::sqrt(1.0 + 1.09 * t1 * t1);
+  for (int k = 3; k < 6; k++) s[k] /= std::sqrt(1.0 + 1.09 * t2 * t2);
+  ContactResult step, again;
+  contact_step(c, FULL, m, delta, 1e-12, false, false, true, s, step);
+  check(step.loss[LOSS_SLIDING] > 0.0 && step.loss[LOSS_ROLLING] > 0.0, "the step clamped "
+        "sliding and rolling (their losses > 0)", step.loss[LOSS_SLIDING], 0.0, 0.0);
+  double stored[7];
+  std::copy(s, s + 7, stored);
+  contact_step(c, FULL, m, delta, 1e-12, true, false, true, s, again);
+  int moved = 0;
+  for (int k = 0; k < 7; k++) moved += s[k] != stored[k];
+  check(moved == 0, "set-up: stored state unchanged (values that moved)", moved, 0, 0);
+  const double dF = norm(again.F1 - step.F1), dM = norm(again.M1 - step.M1);
+  const double dU = std::fabs(again.U[SLIDE] + again.U[ROLL] - step.U[SLIDE] - step.U[ROLL]);
+  check(dF == 0.0 && dM == 0.0 && dU == 0.0, "set-up: the step's force, torque and U again "
+        "(|dF| + |dM| + |dU|)", dF + dM + dU, 0.0, 0.0);
+  double lost = 0.0;
+  for (double l : again.loss) lost += std::fabs(l);
+  check(lost == 0.0, "set-up books nothing", lost, 0.0, 0.0);
+}
+
 // one contact conserves momentum (particle 2 gets -F1 by construction) and angular
 // momentum: d12 x F1 + M1 + M2 = 0 for any pointers, all channels on, inside the limits
 static void angular_momentum()
@@ -208,6 +242,7 @@ int main()
 {
   force_against_eq5();
   clamps();
+  setup_changes_nothing();
   angular_momentum();
   elastic_oscillation();
   std::printf("%d failed\n", failures);
