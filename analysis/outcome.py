@@ -79,9 +79,10 @@ def measure_frame(frame, n_target: int, n_projectile: int, tolerance: float | No
 
 
 def energy_scalings(e_imp: float, n_k: int, e_roll: float | None, e_break: float) -> dict:
-    """E_imp in units of n_k E_roll and of n_k E_break (Wada et al. 2007, Table 1)."""
-    return dict(E_imp_over_nk_Eroll=None if e_roll is None else e_imp / (n_k * e_roll),
-                E_imp_over_nk_Ebreak=e_imp / (n_k * e_break))
+    """E_imp in units of n_k E_roll and of n_k E_break (Wada et al. 2007, Table 1); None
+    where the unit is not defined (no rolling, or n_k = 0: two single grains)."""
+    return dict(E_imp_over_nk_Eroll=None if e_roll is None or n_k == 0 else e_imp / (n_k * e_roll),
+                E_imp_over_nk_Ebreak=None if n_k == 0 else e_imp / (n_k * e_break))
 
 
 class CollisionOutcome(AnalysisBase):

@@ -137,7 +137,8 @@ def summary_text(out: dict) -> str:
         f"contacts per grain n_con    {out['contacts_per_particle']:.3f}  (largest fragment)",
         f"impact energy E_imp         {out['E_imp']:.3e} J"
         + (f" = {out['E_imp_over_nk_Eroll']:.3g} n_k E_roll" if out['E_imp_over_nk_Eroll'] else "")
-        + f" = {out['E_imp_over_nk_Ebreak']:.3g} n_k E_break",
+        + (f" = {out['E_imp_over_nk_Ebreak']:.3g} n_k E_break" if out['E_imp_over_nk_Ebreak']
+           else ""),
     ]
     ended = STOP_WORDS[out["stop_reason"]]
     lines.append(f"run ended                   {ended} at step {out['stop_step']}"

@@ -142,3 +142,21 @@ def test_collision_outcome_is_an_mdanalysis_analysis(run):
     outcome = json.loads((d / "outcome.json").read_text())
     assert by_positions.results.n_largest[-1] == outcome["n_largest"]
     assert list(full.results.N_cum) == outcome["N_cum"]
+
+
+def test_two_single_grains_are_analysed_without_the_aggregate_units(tmp_path):
+    # n_k = N_tar + N_pro - 2 = 0: E_imp / (n_k E_roll) and / (n_k E_break) are undefined, so
+    # the outcome says None for them instead of dividing by zero; at 3 m/s (half the
+    # elastic sticking threshold, tests/test_collision_energy.py) the pair sticks
+    scene_module.write(tmp_path, scene_module.Scene(ICE, 1, 1, v_col=3.0, seed=1))
+    done = subprocess.run([str(BIN / "jkrdt"), "run", str(tmp_path)], capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    said = subprocess.run([str(BIN / "jkrdt"), "analyse", str(tmp_path), "--no-plots"],
+                          capture_output=True, text=True, timeout=120)
+    assert said.returncode == 0 and "Traceback" not in said.stderr, said.stderr
+    out = json.loads((tmp_path / "outcome.json").read_text())
+    assert out["n_k"] == 0
+    assert out["E_imp_over_nk_Eroll"] is None and out["E_imp_over_nk_Ebreak"] is None
+    assert out["n_largest"] == 2 and out["stop_reason"] == "settled"
+    assert "n_k E_break" not in said.stdout and "impact energy E_imp" in said.stdout

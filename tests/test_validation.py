@@ -1,7 +1,8 @@
 """The quick variants of the validation studies: validation/wada2007_2d.py (2D BCCA
 head-on collisions of 2 x 32 grains, quartz and ice, xi_crit = 2 A, 5 speeds, 2 seeds,
 against Wada et al. 2007) and validation/bpca3d_models.py (the 3D BPCA paper's four
-models at 2 x 24 grains)."""
+models at 2 x 24 grains) and validation/two_grain_sticking.py (the sticking threshold of
+two grains without and with the damping of eq. A.5)."""
 
 import json
 import subprocess
@@ -11,6 +12,7 @@ from pathlib import Path
 import pytest
 
 from jkrdt.analysis.tables import read_csv
+from jkrdt.materials import ICE, scales
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -97,3 +99,19 @@ def test_the_four_models_keep_the_papers_order(models):
     small = at["grains_in_fragments_of_at_most_16"]["39.8"]
     assert small["frictionless"] > 2 * small["frictional"]
     assert small["frictionless"] > 2 * small["frictionless, T_vis 6 ps"]
+
+
+def test_two_grains_stick_at_the_elastic_threshold_and_far_above_it_with_damping(tmp_path):
+    # validation/two_grain_sticking.py --quick: without damping the bisected threshold is
+    # eq. (6)'s energy balance (a 1 % bracket, dt = 0.005 t_c moves it by < 0.1 %); T_vis
+    # = 6 ps of eq. (A.5) only adds dissipation, so the threshold can only rise
+    subprocess.run([sys.executable, str(ROOT / "validation" / "two_grain_sticking.py"),
+                    "--quick", "--results", str(tmp_path)], check=True, timeout=300,
+                   capture_output=True)
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    elastic, damped = summary["thresholds"]
+    v_el = summary["elastic_threshold"]
+    assert v_el == pytest.approx(1.9345 * scales(ICE, 1e-7).v0, rel=1e-3)    # sqrt(3.742) v0
+    assert elastic["v_stuck"] <= v_el * 1.003 and elastic["v_bounced"] >= v_el * 0.997
+    assert damped["v_stuck"] > 2.0 * v_el
+    assert (tmp_path / "fig_threshold.png").stat().st_size > 0
