@@ -187,6 +187,29 @@ def test_switching_a_channel_off_books_its_springs_energy(lmp, switch):
                                                                          abs=1e-30)
 
 
+def test_a_limit_lowered_between_runs_is_clamped_and_booked_by_the_next_step(lmp):
+    # a run's set-up takes the stored state as it is: a rolling displacement left beyond a
+    # xi_crit lowered by pair_coeff keeps its spring energy through the set-up, and the
+    # first step clamps it and books the release in the rolling channel
+    two_grain_scene(lmp, 2 * R_GRAIN - S.delta0, coeff_extra="xi_crit 8e-10")
+    lmp.command("set atom 1 omega 0 0 3e6")
+    lmp.command("run 300 post no")
+    before = ledger(lmp)
+    xi = np.sqrt(2.0 * before["p3"] / S.k_r)                  # U_r = k_r xi^2 / 2, eq. (21)
+    assert before["p8"] == 0 and xi > 1e-10                    # held, never clamped
+    lmp.command(f"pair_coeff * * gamma 0.1 E 7e9 nu 0.25 xi_crit {xi / 4}")
+    lmp.command("run 0 post no")
+    setup = ledger(lmp)
+    assert setup["p3"] == before["p3"] and setup["p8"] == 0    # the set-up moved nothing
+    lmp.command("run 1 pre no post no")
+    after = ledger(lmp)
+    # one step on, xi sits at the new limit: U_r = k_r (xi / 4)^2 / 2, and the rest of the
+    # spring's energy is in the rolling channel (a step's rotation changes xi by 1e-4)
+    assert after["p3"] == pytest.approx(0.5 * S.k_r * (xi / 4) ** 2, rel=1e-3)
+    assert after["p8"] == pytest.approx(before["p3"] - after["p3"], rel=1e-2)
+    assert after["total"] == pytest.approx(before["total"], rel=1e-9)
+
+
 def lone_grain_and_stuck_pair(lmp):
     """Atoms 1 and 2 bonded at equilibrium, atom 3 alone far off; one run done."""
     two_grain_scene(lmp, 2 * R_GRAIN - S.delta0)              # atoms 1, 2

@@ -21,6 +21,7 @@ figures fig2_growth and fig3_cumulative (PNG, PDF). Runs go to ``--runs`` (defau
 validation/runs/bpca3d_models, not committed); a second call resumes them.
 
     ./run validate bpca3d_models [--sizes 100 250]   # the study
+    ./run validate bpca3d_models --sizes 100 250 1000 --large-seeds 1 2   # and 2 x 1000
     ./run validate bpca3d_models --quick             # 2 x 24 grains, 3 speeds (tests)
 """
 
@@ -49,14 +50,23 @@ MODELS = {"frictional": ("frictional", 0.0, 60.0),
 FULL = dict(sizes=[100, 250], seeds=[1, 2], b_off2=[0.0, 0.25, 0.5, 0.75],
             v_col=[10.0, 15.8, 20.0, 25.1, 39.8, 63.1, 100.0])
 QUICK = dict(sizes=[24], seeds=[1], b_off2=[0.0, 0.5], v_col=[10.0, 39.8, 100.0])
+#: from this size on, the grid around the v_fra the smaller sizes found (15.8-100 m/s) and
+#: the seeds of --large-seeds: a 2 x 1000 run costs 40-60 s on one core
+LARGE, LARGE_V_COL = 1000, [15.8, 20.0, 25.1, 39.8, 63.1, 100.0]
 SMALL = (1, 4, 16)          # N of the N_cum(<= N) columns
+
+
+def grid(n: int, plan: dict) -> dict:
+    """The speeds, offsets and seeds run at 2 x ``n`` grains."""
+    large = n >= LARGE and "large_seeds" in plan
+    return dict(v_col=LARGE_V_COL if large else plan["v_col"], b_off2=plan["b_off2"],
+                seeds=plan["large_seeds"] if large else plan["seeds"])
 
 
 def spec(model: str, n: int, plan: dict) -> dict:
     kind, tvis, _ = MODELS[model]
     return dict(kind="bpca", dim=3, n_tar=n, n_pro=n, material="ice",
-                material_overrides=dict(tvis=tvis), model=kind, v_col=plan["v_col"],
-                b_off2=plan["b_off2"], seeds=plan["seeds"], dt=0.014)
+                material_overrides=dict(tvis=tvis), model=kind, **grid(n, plan), dt=0.014)
 
 
 def model_curve(where: Path, n_total: int) -> dict:
@@ -166,6 +176,9 @@ def main(argv=None) -> int:
     p.add_argument("--quick", action="store_true", help="the small variant of the tests")
     p.add_argument("--sizes", type=int, nargs="+", default=None,
                    help="grains per aggregate, one campaign set each (default: 100 250)")
+    p.add_argument("--large-seeds", type=int, nargs="+", default=[1],
+                   help=f"the seeds of sizes from {LARGE} on, run at v_col = "
+                   f"{', '.join(f'{v:g}' for v in LARGE_V_COL)} m/s (default: %(default)s)")
     p.add_argument("--np", type=int, default=min(2, os.cpu_count() or 1),
                    help="MPI ranks, one collision each (default %(default)s)")
     p.add_argument("--runs", type=Path, default=None)
@@ -174,6 +187,8 @@ def main(argv=None) -> int:
     plan = dict(QUICK if args.quick else FULL)
     if args.sizes:
         plan["sizes"] = args.sizes
+    if not args.quick:
+        plan["large_seeds"] = args.large_seeds
     tag = "bpca3d_models" + ("_quick" if args.quick else "")
     runs = args.runs or HERE / "runs" / tag
     results = args.results or HERE / tag
@@ -188,7 +203,8 @@ def main(argv=None) -> int:
         "stop_reason", "stop_step", "energy_error", "kinetic_left")})
         for n, by_model in curves.items() for m, c in by_model.items() for o in c["rows"]]
     write_csv(results / "runs.csv", rows)
-    summary = dict(plan=plan, ranks=args.np, seconds_this_call=time.time() - t0,
+    summary = dict(plan=plan, grids={str(n): grid(n, plan) for n in plan["sizes"]},
+                   ranks=args.np, seconds_this_call=time.time() - t0,
                    load=os.getloadavg()[0], **{str(k): v for k, v in compare(curves).items()},
                    curves={str(n): {m: {k: c[k] for k in ("v_col", "mean_f_gro", "runs",
                                                          "capped", "v_fra")}
