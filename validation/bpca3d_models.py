@@ -14,7 +14,8 @@ Measured against the paper (its 10^5-grain values in brackets):
   close together;
 * <N_cum(<= N)> at 20 and 39.8 m/s (Fig. 3): the frictionless model without damping makes
   orders of magnitude more small fragments;
-* how v_fra moves between the sizes run.
+* how v_fra moves between the sizes run (the committed results: 2 x 100 and 2 x 250 on the
+  full grid with 2 seeds, 2 x 1000 on the grid around v_fra with 1 seed).
 
 Writes ``RESULTS`` (default validation/bpca3d_models/): runs.csv, summary.json and the
 figures fig2_growth and fig3_cumulative (PNG, PDF). Runs go to ``--runs`` (default
@@ -51,7 +52,7 @@ FULL = dict(sizes=[100, 250], seeds=[1, 2], b_off2=[0.0, 0.25, 0.5, 0.75],
             v_col=[10.0, 15.8, 20.0, 25.1, 39.8, 63.1, 100.0])
 QUICK = dict(sizes=[24], seeds=[1], b_off2=[0.0, 0.5], v_col=[10.0, 39.8, 100.0])
 #: from this size on, the grid around the v_fra the smaller sizes found (15.8-100 m/s) and
-#: the seeds of --large-seeds: a 2 x 1000 run costs 40-60 s on one core
+#: the seeds of --large-seeds: a 2 x 1000 run costs 40 s to 5 min on one core
 LARGE, LARGE_V_COL = 1000, [15.8, 20.0, 25.1, 39.8, 63.1, 100.0]
 SMALL = (1, 4, 16)          # N of the N_cum(<= N) columns
 
@@ -134,7 +135,7 @@ def figures(curves: dict, results: Path) -> list[Path]:
     dashes = {m: "--" if "T_vis" in m else "-" for m in MODELS}
     widths = {n: 1 + k for k, n in enumerate(sorted(curves))}
     saved = []
-    fig, ax = plt.subplots(figsize=(7, 5), constrained_layout=True)
+    fig, ax = plt.subplots(figsize=(10, 5), constrained_layout=True)
     for n, by_model in sorted(curves.items()):
         for m, c in by_model.items():
             ax.semilogx(c["v_col"], c["mean_f_gro"], dashes[m], marker="o", ms=3,
@@ -150,9 +151,9 @@ def figures(curves: dict, results: Path) -> list[Path]:
     ax.set_xlabel("v_col (m/s)")
     ax.set_ylabel("<f_gro>")
     ax.set_title("3D BPCA paper Fig. 2 at reduced N (ice, B_off^2 0-9/12)", fontsize=9)
-    ax.legend(fontsize=6, ncol=2)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))    # off the curves
     saved += save(fig, results, "fig2_growth")
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5), constrained_layout=True)
+    fig, axes = plt.subplots(1, 2, figsize=(13, 4.5), constrained_layout=True)
     for ax, v in zip(axes, (20.0, 39.8)):
         for n, by_model in sorted(curves.items()):
             for m, c in by_model.items():
@@ -165,7 +166,8 @@ def figures(curves: dict, results: Path) -> list[Path]:
         ax.set_xlabel("N")
         ax.set_ylabel("<N_cum(<= N)>")
         ax.set_title(f"Fig. 3, v_col = {v:g} m/s", fontsize=9)
-        ax.legend(fontsize=6)
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside right upper", fontsize=7)    # one, off the curves
     saved += save(fig, results, "fig3_cumulative")
     return saved
 
