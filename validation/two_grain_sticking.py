@@ -10,9 +10,10 @@ F_D = (2 T_vis E* / nu^2) a v_n of the 3D BPCA paper's eq. (A.5) a part of the i
 energy goes into damping as well, and the threshold rises. This study bisects v_col for
 each T_vis until the bracket is 0.1 % wide: a run sticks if its contact is bonded when the
 settle rule ends it. The 3D paper's T_vis = 6 ps is "motivated by extrapolation of
-laboratory experiments" (Arakawa & Krijt 2021, who find H2O ice grains stick at about ten
-times the elastic threshold); the ratio measured here says what that choice does to a
-single contact, the first thing to know when aggregates stick better than the paper finds.
+laboratory experiments" (Arakawa & Krijt 2021, who find the measured sticking threshold of
+H2O ice particles an order of magnitude above the elastic one); the ratio measured here says
+what that choice does to a single contact, the first thing to know when aggregates stick
+better than the paper finds.
 
 Writes ``RESULTS`` (default validation/two_grain_sticking/): summary.json and
 fig_threshold (PNG, PDF).
