@@ -9,6 +9,8 @@
 #include "comm.h"
 #include "error.h"
 #include "force.h"
+#include "group.h"
+#include "modify.h"
 #include "timer.h"
 #include "update.h"
 #include "utils.h"
@@ -25,9 +27,11 @@ using namespace LAMMPS_NS;
 
 FixJKRDTSettle::FixJKRDTSettle(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), window(5), tolerance(0.01), cap(-1.0), state(RUNNING), last_check(-1),
-    now{0, 0, 0, 0.0}
+    now{0, 0, 0, 0.0}, depart(DEPART_NO), departed_bit(0), moving_bits(0), quiet_speed(0.0),
+    departed_grains(0.0), departed_fragments(0.0)
 {
-  const char *usage = "fix ID all jkr/dt/settle N window K tolerance f [cap T]";
+  const char *usage =
+      "fix ID all jkr/dt/settle N window K tolerance f [cap T] [depart yes|no|shadow]";
   if (narg < 4) error->all(FLERR, "fix jkr/dt/settle: expected '{}'", usage);
   if (igroup != 0)
     error->all(FLERR, "fix jkr/dt/settle: the fragments are those of all atoms; use group all");
@@ -47,6 +51,12 @@ FixJKRDTSettle::FixJKRDTSettle(LAMMPS *lmp, int narg, char **arg) :
     } else if (key == "cap") {
       cap = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
       if (!(cap > 0.0)) error->all(FLERR, "fix jkr/dt/settle: cap is a simulated time > 0");
+    } else if (key == "depart") {
+      const std::string how = arg[iarg + 1];
+      if (how == "yes") depart = DEPART_YES;
+      else if (how == "no") depart = DEPART_NO;
+      else if (how == "shadow") depart = DEPART_SHADOW;
+      else error->all(FLERR, "fix jkr/dt/settle: depart is yes, no or shadow (got '{}')", how);
     } else {
       error->all(FLERR, "fix jkr/dt/settle: unknown keyword '{}'; expected '{}'", key, usage);
     }
@@ -54,7 +64,7 @@ FixJKRDTSettle::FixJKRDTSettle(LAMMPS *lmp, int narg, char **arg) :
   if (cap > 0.0) cap += simulated_time();    // the cap counts from the fix's definition
   restart_global = 1;
   vector_flag = 1;
-  size_vector = 5;
+  size_vector = 7;
   global_freq = 1;
   extvector = 0;
 }
@@ -64,10 +74,36 @@ int FixJKRDTSettle::setmask()
   return FixConst::END_OF_STEP;
 }
 
+void FixJKRDTSettle::post_constructor()
+{
+  // the group exists before the pair style's init looks for it
+  if (depart == DEPART_YES) {
+    departed_bit = group->bitmask[group->find_or_create(PairJKRDT::DEPARTED_GROUP)];
+    force_reneighbor = 1;    // a departure reaches the ghost atoms' masks at the next step
+    next_reneighbor = -1;
+  }
+}
+
 void FixJKRDTSettle::init()
 {
-  if (!dynamic_cast<PairJKRDT *>(force->pair_match("jkr/dt", 1, 0)))
-    error->all(FLERR, "fix jkr/dt/settle requires pair_style jkr/dt");
+  auto *pair = dynamic_cast<PairJKRDT *>(force->pair_match("jkr/dt", 1, 0));
+  if (!pair) error->all(FLERR, "fix jkr/dt/settle requires pair_style jkr/dt");
+  if (depart == DEPART_NO) return;
+  double lightest;
+  const double weakest = pair->weakest_contact(lightest);
+  quiet_speed = std::sqrt(weakest / lightest);
+  if (depart != DEPART_YES) return;
+  moving_bits = 0;
+  for (const auto *fix : modify->get_fix_list()) {
+    if (!fix->time_integrate) continue;
+    if (fix->igroup == 0)
+      error->all(FLERR,
+                 "fix jkr/dt/settle depart yes: fix {} integrates group all, so departed "
+                 "fragments would keep moving; integrate a group of its own instead "
+                 "('group moving subtract all {}' and 'fix {} moving {}')",
+                 fix->id, PairJKRDT::DEPARTED_GROUP, fix->id, fix->style);
+    moving_bits |= fix->groupbit;
+  }
 }
 
 void FixJKRDTSettle::setup(int)
@@ -77,7 +113,8 @@ void FixJKRDTSettle::setup(int)
   state = RUNNING;
   if (update->ntimestep < last_check) history.clear();
   if (history.empty()) {
-    now = partition();
+    Graph graph;
+    now = partition(graph);
     last_check = update->ntimestep;
     history.push_back(now);
   }
@@ -88,7 +125,13 @@ void FixJKRDTSettle::setup(int)
    all ranks, each contact taken once (from the atom with the smaller ID)
 ------------------------------------------------------------------------- */
 
-FixJKRDTSettle::Partition FixJKRDTSettle::partition() const
+int FixJKRDTSettle::Graph::root(int k)
+{
+  while (parent[k] != k) k = parent[k] = parent[parent[k]];
+  return k;
+}
+
+FixJKRDTSettle::Partition FixJKRDTSettle::partition(Graph &graph) const
 {
   auto *pair = dynamic_cast<PairJKRDT *>(force->pair_match("jkr/dt", 1, 0));
   const FixJKRDTContacts *C = pair ? pair->contacts() : nullptr;
@@ -107,8 +150,9 @@ FixJKRDTSettle::Partition FixJKRDTSettle::partition() const
   const std::vector<tagint> edges = FixJKRDTContacts::gather(mine, world);
 
   // union by size over the atoms that have contacts; the others are single grains
-  std::unordered_map<tagint, int> index;
-  std::vector<int> parent, size;
+  auto &index = graph.index;
+  auto &parent = graph.parent;
+  auto &size = graph.size;
   auto node = [&](tagint t) {
     auto it = index.find(t);
     if (it != index.end()) return it->second;
@@ -118,10 +162,7 @@ FixJKRDTSettle::Partition FixJKRDTSettle::partition() const
     size.push_back(1);
     return k;
   };
-  auto root = [&](int k) {
-    while (parent[k] != k) k = parent[k] = parent[parent[k]];
-    return k;
-  };
+  auto root = [&](int k) { return graph.root(k); };
   bigint unions = 0;
   for (size_t e = 0; e < edges.size(); e += 2) {
     int a = root(node(edges[e])), b = root(node(edges[e + 1]));
@@ -149,7 +190,8 @@ double FixJKRDTSettle::simulated_time() const
 void FixJKRDTSettle::end_of_step()
 {
   if (state != RUNNING) return;
-  now = partition();
+  Graph graph;
+  now = partition(graph);
   last_check = update->ntimestep;
   history.push_back(now);
   while (static_cast<int>(history.size()) > window + 1) history.pop_front();
@@ -169,7 +211,11 @@ void FixJKRDTSettle::end_of_step()
     }
   }
   // the cap is met when the next check would lie beyond it
-  if (cap > 0.0 && simulated_time() + 0.5 * nevery * update->dt > cap) stop(CAP);
+  if (cap > 0.0 && simulated_time() + 0.5 * nevery * update->dt > cap) {
+    stop(CAP);
+    return;
+  }
+  if (depart != DEPART_NO) find_departures(graph);
 }
 
 void FixJKRDTSettle::stop(int reason)
@@ -196,7 +242,9 @@ double FixJKRDTSettle::compute_vector(int n)
     case 1: return static_cast<double>(now.n_largest);
     case 2: return static_cast<double>(now.n_fragments);
     case 3: return static_cast<double>(now.contacts);
-    default: return static_cast<double>(last_check);
+    case 4: return static_cast<double>(last_check);
+    case 5: return departed_grains;
+    default: return departed_fragments;
   }
 }
 

@@ -1,6 +1,6 @@
 /* jkr/dt: fix jkr/dt/settle, which ends a run when the collision has ended.
 
-     fix ID all jkr/dt/settle N window K tolerance f [cap T]
+     fix ID all jkr/dt/settle N window K tolerance f [cap T] [depart yes|no|shadow]
 
    Every N steps it finds the fragments: the connected components of the
    bonded-contact graph of pair jkr/dt over all ranks. The collision has
@@ -21,7 +21,19 @@
    The window carries over from one run to the next (a run in chunks) unless
    the step count goes back. It is carried through restart files (to a fix
    of the same ID defined after read_restart), so a run continued from one
-   with the remaining cap stops where the uninterrupted run would have.    */
+   with the remaining cap stops where the uninterrupted run would have.
+
+   depart yes: at each check, a fragment that has left the collision for
+   good departs (fix_jkr_dt_settle_depart.cpp has the rule): its grains join
+   group jkrdt_departed and leave the groups of the time integrators, so they
+   keep their positions, velocities, spins and contacts but no longer move or
+   interact; the box stops growing with them. Their energy stays in ke,
+   erotate and pe (constant), so the conserved total is unchanged, and their
+   contacts still count in the fragments. Vector values 6 and 7 are the
+   departed grains and fragments. depart shadow only writes, once per
+   fragment, the line "jkr/dt/settle: would depart step S label L size N"
+   (L the smallest atom ID) so that the rule can be checked against a run
+   that keeps every fragment.                                                */
 
 #ifndef JKR_DT_FIX_SETTLE_H
 #define JKR_DT_FIX_SETTLE_H
@@ -29,12 +41,16 @@
 #include "fix.h"
 
 #include <deque>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
 
 namespace LAMMPS_NS {
 
 class FixJKRDTSettle : public Fix {
  public:
   enum State { RUNNING = 0, SETTLED, CAP };
+  enum Depart { DEPART_NO = 0, DEPART_YES, DEPART_SHADOW };
   struct Partition {
     bigint n_largest, n_fragments, contacts;
     double dissipated;    // all channels of the contact fix's ledger, summed over ranks
@@ -43,6 +59,7 @@ class FixJKRDTSettle : public Fix {
   FixJKRDTSettle(class LAMMPS *, int, char **);
   int setmask() override;
   void init() override;
+  void post_constructor() override;
   void setup(int) override;
   void end_of_step() override;
   void post_run() override;
@@ -59,7 +76,20 @@ class FixJKRDTSettle : public Fix {
   Partition now;
   std::deque<Partition> history;    // the last K + 1 checks
 
-  Partition partition() const;
+  // the fragments: union-find over the bonded contacts of all ranks, the same on every
+  // rank; atoms without contacts are not nodes (single grains)
+  struct Graph {
+    std::unordered_map<tagint, int> index;    // atom ID -> node
+    std::vector<int> parent, size;
+    int root(int k);
+  };
+  Partition partition(Graph &graph) const;
+  int depart;                    // Depart
+  int departed_bit, moving_bits; // the departed group's bit; the integrators' groups' bits
+  double quiet_speed;            // a grain this fast against its fragment can break a contact
+  double departed_grains, departed_fragments;
+  std::unordered_set<tagint> shadowed;    // fragments reported by depart shadow
+  void find_departures(Graph &graph);
   double simulated_time() const;
   void stop(int reason);
 };

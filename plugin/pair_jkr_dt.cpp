@@ -38,6 +38,7 @@
 #include "comm.h"
 #include "domain.h"
 #include "error.h"
+#include "group.h"
 #include "memory.h"
 #include "modify.h"
 #include "neigh_list.h"
@@ -55,11 +56,12 @@ using namespace LAMMPS_NS;
 using Contacts = FixJKRDTContacts;
 
 const char *const PairJKRDT::FIX_ID = "JKR_DT_CONTACTS";
+const char *const PairJKRDT::DEPARTED_GROUP = "jkrdt_departed";
 
 /* ---------------------------------------------------------------------- */
 
 PairJKRDT::PairJKRDT(LAMMPS *lmp) :
-    Pair(lmp), fix_contacts(nullptr), threads_logged(0), nstride(0),
+    Pair(lmp), fix_contacts(nullptr), departed_bit(0), threads_logged(0), nstride(0),
     dt_check(DT_CHECK_ERROR), tc_min(0.0), tc_types{0, 0}, tc_logged(0.0), dt_logged(0.0),
     dt_warned(0.0), checked_laststep(-1), step_max(0.0),
     step_warned(false), contacts_at_run_end(0), data_contacts(0)
@@ -140,6 +142,9 @@ void PairJKRDT::init_style()
       if (present)
         type_constants[i * nstride + j] = JKRDT::contact_constants(par(i, j), minrad[i], minrad[j]);
     }
+
+  const int departed = group->find(DEPARTED_GROUP);
+  departed_bit = departed >= 0 ? group->bitmask[departed] : 0;
 
   neighbor->add_request(this, NeighConst::REQ_NEWTON_OFF);
 
@@ -314,8 +319,10 @@ void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, A
   const double *radius = atom->radius;
   const tagint *tag = atom->tag;
   const int *type = atom->type;
+  const int *mask = atom->mask;
+  const int departed = departed_bit;
   const int nlocal = atom->nlocal;
-  const bool setup = update->setupflag;
+  const bool run_setup = update->setupflag;
   const double dt = update->dt;
   const double half_skin = 0.5 * neighbor->skin;
   double **f = atom->f, **tq = atom->torque, **ledger = fix_contacts->ledger;
@@ -369,6 +376,15 @@ void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, A
       const double radsum = radius[p] + radius[q];
       if (!bonded && rsq > radsum * radsum) continue;
 
+      // a grain of a fragment that has left for good meets nothing, and its own contacts
+      // stand still: they are only evaluated, as a set-up does, for their potential energy
+      const bool parked = departed && ((mask[p] | mask[q]) & departed);
+      if (parked && !(bonded && eflag)) {
+        if (bonded) acc.contacts += 0.5 * ((p < nlocal ? 1.0 : 0.0) + (q < nlocal ? 1.0 : 0.0));
+        continue;
+      }
+      const bool setup = run_setup || parked;
+
       const double r = std::sqrt(rsq);
       const double delta = radsum - r;    // eq. (3)
       if (!std::isfinite(delta) || r == 0.0) return trouble(Trouble::BLOW_UP, p, q, r, 0.0);
@@ -399,7 +415,7 @@ void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, A
       m.vn = JKRDT::dot(m.v12, d12) * m.rinv;    // at the half step, > 0 when separating
 
       // a step must resolve the contact: name a pair too fast for the list
-      const double step = std::fabs(m.vn) * dt;
+      const double step = parked ? 0.0 : std::fabs(m.vn) * dt;
       if (step > half_skin) return trouble(Trouble::FAST_PAIR, p, q, m.vn, 0.0);
       if (!setup) acc.step_max = std::max(acc.step_max, step / K.S.delta_c);
 
@@ -429,7 +445,7 @@ void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, A
         const V3 &f, &m;
       } sides[2] = {{p, p_own, p_mine, fp, out.M1}, {q, q_own, q_mine, fq, out.M2}};
       for (const auto &side : sides) {
-        if (!side.own) continue;
+        if (!side.own || parked) continue;
         const int a = side.atom;
         double *fa, *ta, *la;
         if (side.mine) {

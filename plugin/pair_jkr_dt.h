@@ -52,6 +52,9 @@ class PairJKRDT : public Pair {
 
   static constexpr int NPVECTOR = 10;
   static const char *const FIX_ID;
+  // the group of grains in fragments that have left the collision for good (fix
+  // jkr/dt/settle depart): they keep their velocities but no longer move or interact
+  static const char *const DEPARTED_GROUP;
 
   // time-step guards (pair_jkr_dt_guards.cpp), in units of t_c = sqrt(m delta_c / F_c), eq. (49)
   static constexpr double DT_WARN = 0.1;      // above: energy errors of 1e-3 and more
@@ -80,6 +83,9 @@ class PairJKRDT : public Pair {
   bool bonded_contact(int i, int j, ContactView &view) const;
   void report_run();         // end of a run: the largest step a contact took
   double t_c() const { return tc_min; }
+  // the least energy that breaks a bonded contact, eq. (6) from equilibrium to -delta_c,
+  // over the type pairs present, and the mass of the lightest grain
+  double weakest_contact(double &lightest) const;
   // the contact store with its per-atom rows current (for readers between the steps)
   FixJKRDTContacts *contacts();
   void report_lost_contact();    // a stored contact missing from the neighbor list
@@ -105,6 +111,7 @@ class PairJKRDT : public Pair {
   bigint contacts_at_run_end;  // bonded contacts when the last run ended (write_data marks it)
   bigint data_contacts;        // contacts a data file read by read_data left behind
   FixJKRDTContacts *fix_contacts;
+  int departed_bit;            // mask bit of DEPARTED_GROUP; 0 while the group does not exist
 
   int nstride;                 // ntypes + 1
   Input &in(int i, int j) { return input[i * nstride + j]; }

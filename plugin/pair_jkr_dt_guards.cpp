@@ -141,6 +141,27 @@ void PairJKRDT::find_contact_time()
 }
 
 /* ----------------------------------------------------------------------
+   E_break of the weakest contact present: U_n of eq. (6) at the break point
+   y_break (delta = -delta_c) above its equilibrium value at y = 1
+------------------------------------------------------------------------- */
+
+double PairJKRDT::weakest_contact(double &lightest) const
+{
+  double weakest = std::numeric_limits<double>::infinity();
+  lightest = std::numeric_limits<double>::infinity();
+  const double ratio = JKRDT::potential_ratio_at_break() - JKRDT::normal_potential_ratio(1.0);
+  for (int i = 1; i <= atom->ntypes; i++)
+    for (int j = i; j <= atom->ntypes; j++) {
+      if (!std::isfinite(minrad[i]) || !std::isfinite(minrad[j])) continue;    // type absent
+      const Param &P = par(i, j);
+      const auto S = JKRDT::normal_scales(minrad[i], minrad[j], P.gamma, P.a0_coef);
+      weakest = std::min(weakest, ratio * S.F_c * S.delta_c);
+      lightest = std::min({lightest, minmass[i], minmass[j]});
+    }
+  return weakest;
+}
+
+/* ----------------------------------------------------------------------
    once per run (at its set-up, or at its first step for 'run N pre no',
    which has no set-up): dt / t_c to the log, and the limits for a run with steps
 ------------------------------------------------------------------------- */

@@ -1,8 +1,9 @@
 """The quick variants of the validation studies: validation/wada2007_2d.py (2D BCCA
 head-on collisions of 2 x 32 grains, quartz and ice, xi_crit = 2 A, 5 speeds, 2 seeds,
 against Wada et al. 2007) and validation/bpca3d_models.py (the 3D BPCA paper's four
-models at 2 x 24 grains) and validation/two_grain_sticking.py (the sticking threshold of
-two grains without and with the damping of eq. A.5)."""
+models at 2 x 24 grains), validation/two_grain_sticking.py (the sticking threshold of
+two grains without and with the damping of eq. A.5) and validation/departure.py (fragments
+that depart against fragments kept flying, 2 x 50 grains shattering, 4 seeds)."""
 
 import json
 import subprocess
@@ -115,3 +116,23 @@ def test_two_grains_stick_at_the_elastic_threshold_and_far_above_it_with_damping
     assert elastic["v_stuck"] <= v_el * 1.003 and elastic["v_bounced"] >= v_el * 0.997
     assert damped["v_stuck"] > 2.0 * v_el
     assert (tmp_path / "fig_threshold.png").stat().st_size > 0
+
+
+def test_departed_fragments_leave_the_outcomes_as_they_were(tmp_path):
+    # the quick departure study: 2 x 50 frictionless ice grains head-on at 39.8 m/s, 4
+    # seeds, with departures and with every fragment kept flying (depart shadow). The
+    # rule lets hundreds of fragments go; none of them would have been touched again
+    # (same smallest ID and size at the end of the run that kept it flying), and f_gro,
+    # N_lar / N and N_cum(<= 1, 4, 16) agree within two combined standard errors
+    results = run_quick("departure", tmp_path)
+    summary = json.loads((results / "summary.json").read_text())["comparison"]
+    rule = summary.pop("rule")
+    errors = summary.pop("energy_error_max")
+    assert rule["runs"] == 4 and rule["would_depart"] > 100
+    assert rule["wrong"] <= 0.01 * rule["would_depart"]
+    assert max(errors.values()) < 1e-3
+    (case,) = summary.values()
+    assert case["runs"] == {"yes": 4, "shadow": 4}
+    for measure in ("f_gro", "N_lar_over_N", "N_cum_le_1_over_N", "N_cum_le_4_over_N",
+                    "N_cum_le_16_over_N"):
+        assert case[measure]["agree"], measure

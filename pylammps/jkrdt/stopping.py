@@ -11,7 +11,14 @@ over the last ``window`` checks,
   energy dissipated so far (restructuring has stopped).
 
 A run that has not settled by ``cap_tc`` (simulated time, in t_c) stops there with
-reason "cap". The defaults below check every 50 t_c over 5 checks (250 t_c, about
+reason "cap".
+
+At each check, fragments that have left the collision for good depart (``depart``
+"yes"; the rule is in the plugin's ``fix_jkr_dt_settle_depart.cpp`` and the README's
+"Fragments that fly apart"): they keep their velocities, spins and contacts but stop
+and meet nothing more, so the box, the neighbor bins and the cost per step stop growing
+with them. "no" lets every fragment fly; "shadow" lets them fly and logs, once per
+fragment, when the rule would have let it depart (to measure the rule). The defaults below check every 50 t_c over 5 checks (250 t_c, about
 70 ns for 0.1 micron ice), which is longer than a grain's contact time and shorter
 than a collision of a few hundred grains.
 
@@ -36,6 +43,10 @@ STOP_WORDS = {"settled": "settled", "cap": "hit the cap before settling",
               "error": "FAILED", "cut off": "was CUT OFF"}
 
 
+#: what fix jkr/dt/settle's depart keyword takes
+DEPART = ("yes", "no", "shadow")
+
+
 @dataclasses.dataclass(frozen=True)
 class SettleRule:
     """The settle rule's parameters (see the module docstring)."""
@@ -44,6 +55,7 @@ class SettleRule:
     window: int = 5               # checks that must agree
     tolerance: float = 0.01       # relative change of contacts and dissipation allowed
     cap_tc: float = 40000.0       # simulated time at which an unsettled run stops, t_c
+    depart: str = "yes"           # fragments that have left for good stop: yes, no, shadow
 
     def __post_init__(self):
         if not self.check_tc > 0:
@@ -53,6 +65,8 @@ class SettleRule:
                              f"(got {self.window})")
         if not 0 <= self.tolerance < 1:
             raise ValueError(f"settle tolerance is a fraction in [0, 1) (got {self.tolerance})")
+        if self.depart not in DEPART:
+            raise ValueError(f"settle depart must be one of {DEPART} (got {self.depart!r})")
         if not self.cap_tc > self.check_tc:
             raise ValueError(f"settle cap ({self.cap_tc} t_c) must exceed the check interval "
                              f"({self.check_tc} t_c)")
@@ -69,7 +83,8 @@ class SettleRule:
     def deck_variables(self, dt_over_tc: float) -> dict:
         """Variables of ``inputs/collision.lmp`` that switch the rule on."""
         return dict(settle="yes", every=self.check_steps(dt_over_tc), window=self.window,
-                    settle_tol=self.tolerance, steps=self.cap_steps(dt_over_tc))
+                    settle_tol=self.tolerance, steps=self.cap_steps(dt_over_tc),
+                    depart=self.depart)
 
 
 #: the rule of ``jkrdt run``, ``jkrdt demo``, campaigns and ``Session.run_until_settled``
