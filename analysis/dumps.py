@@ -1,6 +1,7 @@
 """Reading a run's dumps, one frame at a time.
 
-* ``atoms.dump`` (``dump custom ... id type radius x y z vx vy vz c_coord``) is read
+* ``atoms.dump`` (``dump custom ... id type radius x y z vx vy vz c_coord
+  d_departed_at``: the last, the time a grain's fragment departed, 0 if it did not) is read
   with MDAnalysis' LAMMPSDUMP reader; the extra per-atom columns (radius, the
   coordination c_coord, ...) come with each frame. MDAnalysis keeps positions in
   float32 and shifts them so that the box starts at 0: distances are good to about
@@ -25,7 +26,11 @@ import numpy as np
 CONTACT_COLUMNS = ["id1", "id2", "delta", "a", "force", "zeta", "xi", "phi"]
 
 
-def atoms_universe(path, columns=("radius", "c_coord")):
+#: the per-atom column of the time (s) a departed grain left; 0 for the others
+DEPARTED_AT = "d_departed_at"
+
+
+def atoms_universe(path, columns=("radius", "c_coord", DEPARTED_AT)):
     """An MDAnalysis Universe over a ``dump custom`` file with the given extra columns
     (those present in the file) in each frame's ``ts.data``."""
     import MDAnalysis as mda

@@ -96,7 +96,9 @@ class CollisionOutcome(AnalysisBase):
     ``n_second``, ``n_fragments``, ``growth_efficiency``, ``gyration_radius_largest``
     and ``contacts_per_particle`` (arrays), and for the last frame analysed its
     ``labels`` (fragment of each atom, by ascending ID), ``positions``, ``has_contacts``,
-    ``fragment_sizes`` and ``N_cum`` (grains in fragments of at most N grains), with the
+    ``fragment_sizes`` and ``N_cum`` (grains in fragments of at most N grains), its
+    ``velocities`` (None where the dump has none) and ``departed_at`` (the time each
+    grain's fragment departed, 0 if it did not or the dump does not say), with the
     atoms' ``types`` (1 target, 2 projectile) and the first analysed frame's
     ``first_positions``. A contact
     snapshot cut off by the end of its file (a run killed while dumping) ends the
@@ -147,13 +149,18 @@ class CollisionOutcome(AnalysisBase):
             self.results[name].append(getattr(outcome, name))
         if self._last is None:
             self.results.first_positions = frame.x
-        self._last = frame, labels
+        from .dumps import DEPARTED_AT
+        departed_at = (np.asarray(ts.data[DEPARTED_AT][self._order], dtype=np.float64)
+                       if DEPARTED_AT in ts.data else np.zeros(len(self._ids)))
+        velocities = (self._atoms.velocities[self._order].astype(np.float64)
+                      if ts.has_velocities else None)
+        self._last = frame, labels, departed_at, velocities
 
     def _conclude(self):
         for name in self.MEASURES:
             self.results[name] = np.asarray(self.results[name])
         if self._last is not None:
-            frame, labels = self._last
+            frame, labels, self.results.departed_at, self.results.velocities = self._last
             sizes, cumulative = frag.cumulative_number(labels)
             self.results.labels, self.results.positions = labels, frame.x
             self.results.has_contacts = frame.pairs is not None

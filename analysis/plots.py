@@ -71,7 +71,7 @@ def _frame_axes(ax, x, i, j, radius, names) -> float:
     ax.set_xlabel(f"{names[i]} (micron)")
     ax.set_ylabel(f"{names[j]} (micron)")
     if diameter > 2 * radius * 1e6:
-        ax.text(0.01, 0.01, f"grains drawn {diameter / (2 * radius * 1e6):.0f}x enlarged",
+        ax.text(0.01, 0.01, f"grains drawn {diameter / (2 * radius * 1e6):.2g}x enlarged",
                 transform=ax.transAxes, fontsize=7, color="0.4")
     return diameter
 
@@ -82,13 +82,14 @@ def _when(step, time, t_c) -> str:
 
 def outcome(path, start: np.ndarray, end: np.ndarray, body: np.ndarray, labels: np.ndarray,
             radius: float, dim: int, when: tuple, t_c: float, b: float | None = None,
-            title: str = "") -> list[Path]:
+            title: str = "", departed: np.ndarray | None = None) -> list[Path]:
     """The collision at its first and last frame (columns), in x-y and, in 3D, x-z
     (rows), grains to scale. At the start the target and the projectile have their own
     colours, with the impact direction (the projectile moves along -x) and the offset b
     drawn; at the end the five largest fragments have their own colours (grains from the
     projectile in a lighter shade of it) and the others are faint.
-    ``when`` = ((step, time in s) of the start, (step, time) of the end)."""
+    ``when`` = ((step, time in s) of the start, (step, time) of the end); ``departed``
+    marks the grains of fragments that departed (drawn where they fly at the end)."""
     plt = _pyplot()
     from matplotlib.colors import to_rgb
     from matplotlib.lines import Line2D
@@ -150,6 +151,10 @@ def outcome(path, start: np.ndarray, end: np.ndarray, body: np.ndarray, labels: 
     if len(rest):
         handles.append(Patch(color="0.75", label=f"{len(rest)} more, of at most "
                              f"{grains(sizes[rest].max())}"))
+    if departed is not None and departed.any():
+        n_gone = len(np.unique(labels[departed]))
+        handles.append(Patch(color="none", label=f"{n_gone} fragment(s), {grains(departed.sum())}"
+                             ", departed:\ndrawn where they fly at the end"))
     axes[0, 1].legend(handles=handles, fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1),
                       title=f"{len(sizes)} fragment(s)", title_fontsize=8)
     fig.suptitle(title, fontsize=10)

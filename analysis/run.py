@@ -32,6 +32,22 @@ class RunNotComplete(ValueError):
     """A run that failed or was cut off, analysed without ``partial=True``."""
 
 
+def flown(x: np.ndarray, measured, t_end: float) -> np.ndarray:
+    """Positions at ``t_end`` with each departed fragment moved on from where it stopped at
+    the velocity of its centre of mass (equal grains) since its departure: it flies on
+    as a rigid body, and its spin, which turns it about that centre, is left out."""
+    departed = measured.departed_at > 0
+    if not departed.any() or measured.velocities is None:
+        return x
+    labels = measured.labels
+    count = np.bincount(labels)
+    centre_v = np.stack([np.bincount(labels, measured.velocities[:, k]) / count
+                         for k in range(3)], axis=1)
+    x = x.copy()
+    x[departed] += centre_v[labels[departed]] * (t_end - measured.departed_at[departed])[:, None]
+    return x
+
+
 def analyse_run(run, tolerance: float | None = None, plots: bool = True,
                 partial: bool = False) -> dict:
     """Analyse ``run``; returns what ``outcome.json`` holds. ``tolerance`` (m, default
@@ -113,9 +129,10 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
                      f"max |dE|/E_imp = {out['energy_error']:.1e}")
         step_s = scene.time_step()[0] * s.t_c          # the time of a frame without a log
         moments = [(r["step"], r.get("time", r["step"] * step_s)) for r in (rows[0], rows[-1])]
-        pictures = outcome(run / "outcome", measured.first_positions, x_last, measured.types,
+        pictures = outcome(run / "outcome", measured.first_positions,
+                           flown(x_last, measured, moments[1][1]), measured.types,
                            labels, scene.radius, scene.dim, moments, s.t_c, b=meta.get("b"),
-                           title=f"{title}\n{when}")
+                           title=f"{title}\n{when}", departed=measured.departed_at > 0)
         pictures += timeline(run / "timeline", rows, n_tar + n_pro, meta["E_imp"], s.t_c, title)
         if budget is not None:
             pictures += energy_partition(run / "energy", thermo["Time"], budget, meta["E_imp"],

