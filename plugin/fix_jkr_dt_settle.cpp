@@ -28,6 +28,7 @@ using namespace LAMMPS_NS;
 FixJKRDTSettle::FixJKRDTSettle(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), window(5), tolerance(0.01), cap(-1.0), state(RUNNING), last_check(-1),
     now{0, 0, 0, 0.0}, depart(DEPART_NO), departed_bit(0), moving_bits(0), quiet_speed(0.0),
+    break_energy(0.0),
     departed_grains(0.0), departed_fragments(0.0)
 {
   const char *usage =
@@ -90,8 +91,8 @@ void FixJKRDTSettle::init()
   if (!pair) error->all(FLERR, "fix jkr/dt/settle requires pair_style jkr/dt");
   if (depart == DEPART_NO) return;
   double lightest;
-  const double weakest = pair->weakest_contact(lightest);
-  quiet_speed = std::sqrt(weakest / lightest);
+  break_energy = pair->weakest_contact(lightest);
+  quiet_speed = std::sqrt(break_energy / lightest);
   if (depart != DEPART_YES) return;
   moving_bits = 0;
   for (const auto *fix : modify->get_fix_list()) {

@@ -92,6 +92,7 @@ class FixJKRDTSettle : public Fix {
   int depart;                    // Depart
   int departed_bit, moving_bits; // the departed group's bit; the integrators' groups' bits
   double quiet_speed;            // a grain this fast against its fragment can break a contact
+  double break_energy;           // E_break of the weakest contact
   double departed_grains, departed_fragments;
   std::unordered_set<tagint> shadowed;    // fragments reported by depart shadow
   void find_departures(Graph &graph);

@@ -15,11 +15,13 @@
 
      the two bounding spheres, on their straight lines and growing at
      u_i + u_j, never come within a grain diameter of each other; or
-     i's sphere as it is now, and every grain of i on its own straight line,
-     never come within a grain diameter of j's sphere growing at u_j
+     i's sphere as it is now, and every grain of i that has the energy to
+     break free (1/2 m u^2 above E_break times its contacts) on its own
+     straight line, never come within a grain diameter of j's sphere growing
+     at u_j
 
-   (the second lets a small fragment leave a hot remnant whose fast grains
-   fly elsewhere). never_meet() is the exact least distance of a point and a
+   (the second lets a small fragment leave a hot remnant: its bound grains
+   stay inside it, and its fast free ones fly elsewhere). never_meet() is the exact least distance of a point and a
    growing sphere on straight lines. The rule is exact for bodies that are
    rigid or slower inside than u; it can be wrong when a fragment heats up
    after the check (a later collision inside it). How often, is measured
@@ -28,10 +30,14 @@
 
 #include "fix_jkr_dt_settle.h"
 
+#include "fix_jkr_dt_contacts.h"
+#include "pair_jkr_dt.h"
+
 #include "atom.h"
 #include "comm.h"
 #include "domain.h"
 #include "error.h"
+#include "force.h"
 #include "group.h"
 #include "modify.h"
 #include "update.h"
@@ -203,6 +209,7 @@ void FixJKRDTSettle::find_departures(Graph &graph)
 
   // pass 3: bounding radius and internal speed
   std::vector<double> ext(2 * (size_t) M, 0.0), ext_all(2 * (size_t) M);
+  std::vector<double> internal_speed2(nlocal, 0.0);
   for (int i = 0; i < nlocal; i++) {
     const int b = body[i];
     if (b < 0) continue;
@@ -218,6 +225,7 @@ void FixJKRDTSettle::find_departures(Graph &graph)
     }
     ext[2 * b] = std::max(ext[2 * b], std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]) + radius[i]);
     ext[2 * b + 1] = std::max(ext[2 * b + 1], std::sqrt(u2));
+    internal_speed2[i] = u2;
   }
   MPI_Allreduce(ext.data(), ext_all.data(), 2 * M, MPI_DOUBLE, MPI_MAX, world);
   for (int b = 0; b < M; b++) {
@@ -225,11 +233,17 @@ void FixJKRDTSettle::find_departures(Graph &graph)
     B[b].u = ext_all[2 * b + 1];
   }
 
-  // the grains of fragments with contacts, every rank's, grouped by fragment: x, v, r
+  // the grains of fragments with contacts that have the energy to break free, every
+  // rank's, grouped by fragment: x, v, r. A grain whose kinetic energy against its
+  // fragment's rigid motion is below E_break per contact it holds cannot break them
+  // all: it stays bound, inside its fragment's sphere
+  auto *pair = dynamic_cast<PairJKRDT *>(force->pair_match("jkr/dt", 1, 0));
+  const FixJKRDTContacts *C = pair->contacts();
   std::vector<double> mine_grains;
   for (int i = 0; i < nlocal; i++) {
     const int b = body[i];
     if (b < 0 || B[b].departed) continue;
+    if (0.5 * rmass[i] * internal_speed2[i] <= C->npartner[i] * break_energy) continue;
     const double *x = &xu[3 * i];
     mine_grains.insert(mine_grains.end(),
                        {(double) b, x[0], x[1], x[2], v[i][0], v[i][1], v[i][2], radius[i]});
