@@ -17,8 +17,8 @@
      u_i + u_j, never come within a grain diameter of each other; or
      i's sphere as it is now, and every grain of i that has the energy to
      break free (1/2 m u^2 above E_break times its contacts) on its own
-     straight line, never come within a grain diameter of j's sphere growing
-     at u_j
+     straight line, never come within a grain diameter of j's sphere
+     growing at u_j
 
    (the second lets a small fragment leave a hot remnant: its bound grains
    stay inside it, and its fast free ones fly elsewhere). never_meet() is the exact least distance of a point and a
@@ -85,8 +85,8 @@ void fit_rotation(const double I[6], const double L[3], double w[3])
 // whether a point at p moving at q (both relative to a sphere's centre) stays farther
 // than reach from it for all t >= 0 while the sphere's radius grows at u: the least of
 // |p + q t| - u t is b sqrt(1 - k^2) - k a, with k = u / |q|, a the distance still to
-// travel to the closest approach and b the miss distance, unless that least lies in the
-// past (then it is |p|, now)
+// travel to the closest approach and b the miss distance, unless that least is now
+// (then it is |p|)
 bool never_meet(const double p[3], const double q[3], double reach, double u)
 {
   const double pp = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
@@ -97,8 +97,8 @@ bool never_meet(const double p[3], const double q[3], double reach, double u)
   const double a = -(p[0] * q[0] + p[1] * q[1] + p[2] * q[2]) / qn;
   const double b = std::sqrt(std::max(0.0, pp * pp - a * a));
   const double root = std::sqrt(1.0 - k * k);
-  const double least = (-k * b / root <= a) ? b * root - k * a : pp;
-  return least > reach;
+  if (-k * b / root > a) return true;    // the least is now: they only draw apart
+  return b * root - k * a > reach;
 }
 
 // the concatenation of every rank's values, in rank order, on every rank

@@ -115,7 +115,7 @@ def test_a_run_continued_from_a_restart_file_departs_as_the_uninterrupted_one(sc
 
     straight = start_lammps()
     read_deck(straight, words, deck=deck)
-    straight.command(f"run {40 * check} post no")
+    straight.command(f"run {12 * check} post no")
     path = tmp_path / "mid.restart"
     straight.command(f"write_restart {path}")
     mid_departed = straight.extract_fix("settle", 0, 1, 5)
