@@ -4,8 +4,8 @@ departure (fix jkr/dt/settle depart yes|no), side by side.
 Two worker processes run the same scene, one check interval (50 t_c) at a time, taking
 turns (A B A B ...), so both see the same machine load. After each chunk a worker reports
 the wall time of the chunk, the box, its resident memory and the departed grains. The
-departing run goes to the settle rule; the other stops at the same simulated time or at
-``--budget`` seconds of its own wall time, whichever comes first.
+departing run goes to the settle rule or ``--until-tc``; the other stops at the same
+simulated time or at ``--budget`` seconds of its own wall time, whichever comes first.
 
     python benchmarks/bench_depart.py                        # 2 x 2500, frictionless, 39.8 m/s
     python benchmarks/bench_depart.py --n 1000 --out /tmp/d.json
@@ -72,6 +72,8 @@ def main(argv=None) -> None:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--budget", type=float, default=900.0,
                     help="wall seconds after which the run without departure stops")
+    ap.add_argument("--until-tc", type=float, default=3000.0,
+                    help="simulated time (t_c) at which both stop, settled or not")
     ap.add_argument("--out", type=Path, default=HERE / "depart" / "depart.json")
     ap.add_argument("--worker", nargs=2, metavar=("SCENE", "DEPART"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
@@ -101,7 +103,7 @@ def main(argv=None) -> None:
             series[d].append(row)
             spent[d] += row["wall"]
             loads.append(os.getloadavg()[0])
-            done = row["state"] != "running"
+            done = row["state"] != "running" or row["t_tc"] >= args.until_tc
             if d == "no":
                 stop_at = series["yes"][-1]["t_tc"] if "yes" not in live else float("inf")
                 done = done or spent[d] > args.budget or row["t_tc"] >= stop_at

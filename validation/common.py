@@ -12,15 +12,18 @@ from pathlib import Path
 BIN = Path(sys.executable).parent
 
 
+def campaign_paths(specs: dict[str, dict], runs: Path) -> dict[str, Path]:
+    """The directory of each spec's campaign below ``runs`` (its spec beside it, .json)."""
+    return {name: runs / re.sub(r"[^A-Za-z0-9.]+", "_", name) for name in specs}
+
+
 def run_campaigns(specs: dict[str, dict], runs: Path, ranks: int) -> dict[str, Path]:
     """Run one ``jkrdt campaign`` per spec (``runs/<name>``), each over ``ranks`` MPI ranks
     in groups of one; a second call resumes them. Returns the campaign directories."""
     runs.mkdir(parents=True, exist_ok=True)
-    where = {}
+    where = campaign_paths(specs, runs)
     for name, spec in specs.items():
-        slug = re.sub(r"[^A-Za-z0-9.]+", "_", name)
-        where[name] = runs / slug
-        path = runs / f"{slug}.json"
+        path = where[name].with_suffix(".json")
         path.write_text(json.dumps(spec))
         cmd = [str(BIN / "jkrdt"), "campaign", str(path), str(where[name]), "--quiet"]
         if ranks > 1:

@@ -15,6 +15,7 @@ Writes ``RESULTS`` (default validation/departure/): runs.csv and summary.json. R
 
     ./run validate departure                  # 2 x 1000, 8 seeds (96 runs)
     ./run validate departure --quick          # 2 x 50, 1 speed, 4 seeds (tests)
+    ./run validate departure --summarise      # the runs finished so far, running nothing
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from common import run_campaigns
+from common import campaign_paths, run_campaigns
 from jkrdt.analysis import dumps, fragments
 from jkrdt.analysis.tables import write_csv
 
@@ -128,15 +129,21 @@ def main(argv=None) -> dict:
     ap.add_argument("--ranks", type=int, default=os.cpu_count() or 1)
     ap.add_argument("--runs", type=Path, default=HERE / "runs" / "departure")
     ap.add_argument("--results", type=Path, default=HERE / "departure")
+    ap.add_argument("--summarise", action="store_true",
+                    help="summarise the runs finished so far, run nothing (a study in progress)")
     args = ap.parse_args(argv)
     plan = QUICK if args.quick else FULL
     specs = {f"{m} depart {d}": spec(m, d, plan) for m in plan["models"] for d in VARIANTS}
-    where = run_campaigns(specs, args.runs, args.ranks)
+    where = (campaign_paths(specs, args.runs) if args.summarise
+             else run_campaigns(specs, args.runs, args.ranks))
     rows = []
     for name, path in where.items():
         model, _, depart = name.split()
-        rows += rows_of(path, model, depart)
-    summary = dict(plan=plan, comparison=compare(rows))
+        if path.exists():
+            rows += rows_of(path, model, depart)
+    planned = len(specs) * len(plan["v_col"]) * len(plan["seeds"])
+    summary = dict(plan=plan, runs_planned=planned, runs_finished=len(rows),
+                   comparison=compare(rows))
     args.results.mkdir(parents=True, exist_ok=True)
     write_csv(args.results / "runs.csv", rows)
     (args.results / "summary.json").write_text(json.dumps(summary, indent=1))
