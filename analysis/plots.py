@@ -208,6 +208,9 @@ def energy_partition(path, time: np.ndarray, budget: dict, e_imp: float, title: 
     fig, ax = plt.subplots(figsize=(7, 4.5), constrained_layout=True)
     t = np.asarray(time) * 1e9
     ax.plot(t, budget["kinetic"] / e_imp, label="kinetic (with rotation)", lw=2)
+    if np.any(budget.get("departed", 0) != 0):
+        ax.plot(t, budget["departed"] / e_imp, color="C0", ls="--",
+                label="of it, carried by departed fragments")
     ax.plot(t, (budget["potential"] - budget["potential"][0]) / e_imp, label="potential - U(0)")
     for name in CHANNELS:
         if np.any(budget[name] != 0):

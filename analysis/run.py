@@ -114,7 +114,9 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
         error = energy_error(budget, e_imp)
         t_end = float(thermo["Time"][at[0]] if at.size else thermo["Time"][upto][-1])
         out.update(time_end=t_end, time_end_over_tc=t_end / s.t_c)
-        out.update(kinetic_left=float(left / e_imp), energy_error=error,
+        gone = budget["departed"][at[0]] if at.size else budget["departed"][upto][-1]
+        out.update(kinetic_left=float(left / e_imp), kinetic_departed=float(gone / e_imp),
+                   energy_error=error,
                    energy_warning=error > ENERGY_WARN,
                    dissipated_fraction=float(budget["dissipated"][-1] / e_imp),
                    dissipated_by_channel={name: float(budget[name][-1] / e_imp)
@@ -166,7 +168,9 @@ def summary_text(out: dict) -> str:
     if out.get("problem"):
         lines.append(f"  WARNING                   {out['problem']}; partial outcome")
     if "kinetic_left" in out:
-        lines.append(f"kinetic energy left / E_imp {out['kinetic_left']:.3f}")
+        lines.append(f"kinetic energy left / E_imp {out['kinetic_left']:.3f}"
+                     + (f"  ({out['kinetic_departed']:.3f} in departed fragments)"
+                        if out.get("kinetic_departed") else ""))
     if "dissipated_fraction" in out:
         lines.append(f"dissipated / E_imp          {out['dissipated_fraction']:.3f}  ("
                      + ", ".join(f"{k} {v:.3f}" for k, v in out["dissipated_by_channel"].items())

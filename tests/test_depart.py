@@ -37,7 +37,8 @@ def departed_state(lmp):
     ids = lmp.numpy.extract_atom("id")[:n]
     order = np.argsort(ids[gone])
     grab = {name: lmp.numpy.extract_atom(name)[:n][gone][order].copy()
-            for name in ("x", "v", "omega")}
+            for name in ("x", "v", "omega", "rmass")}
+    grab["kedep"] = float(lmp.extract_compute("kedep", 0, 0))
     return ids[gone][order], grab
 
 
@@ -80,6 +81,9 @@ def test_departed_grains_stand_still_and_keep_their_velocities(shattered):
     for name in ("x", "v", "omega"):
         assert np.array_equal(before[name], last[1][name][kept]), name
     assert np.abs(before["v"]).max() > 1.0              # they left moving, and keep it
+    # the deck's compute kedep is the kinetic energy they carry away, 1/2 m v^2 summed
+    ke = 0.5 * np.sum(last[1]["rmass"] * np.sum(last[1]["v"] ** 2, axis=1))
+    assert last[1]["kedep"] == pytest.approx(ke, rel=1e-12)
 
 
 def test_a_fragment_departs_whole(shattered):

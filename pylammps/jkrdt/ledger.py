@@ -8,7 +8,9 @@ The plugin's compute gives 10 values (its manual page, "Output"):
           sliding, rolling and twisting: the channels of the ledger
     10    the number of bonded contacts
 
-ke + erotate/sphere + pe + values 5-9 is conserved. This module is the one place that
+ke + erotate/sphere + pe + values 5-9 is conserved. The deck's computes kedep and erotdep
+are the part of ke and erotate that fragments which have departed (``jkrdt.stopping``)
+carry away: constant once they are gone, like their contacts' share of pe. This module is the one place that
 layout is written down: the deck's thermo line (``inputs/collision.lmp``, tested to
 match ``THERMO_STYLE``), ``Session``'s samples and the analysis of a log read it from here.
 """
@@ -25,8 +27,10 @@ FIRST_CHANNEL, CONTACT_COUNT = 4, 9
 LEDGER = [f"c_p[{FIRST_CHANNEL + 1 + k}]" for k in range(len(CHANNELS))]
 CONTACTS = f"c_p[{CONTACT_COUNT + 1}]"
 #: the deck's thermo keywords and the names LAMMPS gives their columns in a log
-THERMO_KEYWORDS = ["step", "time", "ke", "c_erot", "pe", *LEDGER, CONTACTS]
-THERMO = ["Step", "Time", "KinEng", "c_erot", "PotEng", *LEDGER, CONTACTS]
+#: the kinetic and rotational energy of the departed fragments (included in ke, c_erot)
+DEPARTED = ["c_kedep", "c_erotdep"]
+THERMO_KEYWORDS = ["step", "time", "ke", "c_erot", "pe", *LEDGER, CONTACTS, *DEPARTED]
+THERMO = ["Step", "Time", "KinEng", "c_erot", "PotEng", *LEDGER, CONTACTS, *DEPARTED]
 THERMO_STYLE = "thermo_style    custom " + " ".join(THERMO_KEYWORDS)
 #: the conserved total as a LAMMPS equal-style formula over the deck's computes p, erot
 CONSERVED = "ke+c_erot+pe+" + "+".join(LEDGER)
@@ -39,16 +43,19 @@ def sample(lmp) -> list[float]:
     return [lmp.get_thermo("step"), lmp.get_thermo("time"), lmp.get_thermo("ke"),
             float(lmp.extract_compute("erot", 0, 0)), lmp.get_thermo("pe"),
             *(float(p[FIRST_CHANNEL + k]) for k in range(len(CHANNELS))),
-            float(p[CONTACT_COUNT])]
+            float(p[CONTACT_COUNT]),
+            *(float(lmp.extract_compute(name[2:], 0, 0)) for name in DEPARTED)]
 
 
 def energy_budget(thermo: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     """Kinetic (with rotation), potential, dissipated (in all and by channel) and total
-    energy over a run, from thermo columns named as in ``THERMO``."""
+    energy over a run, from thermo columns named as in ``THERMO``, and ``departed``: the
+    part of the kinetic energy that departed fragments carry (0 for a log without it)."""
     kinetic = thermo["KinEng"] + thermo["c_erot"]
     dissipated = sum(thermo[c] for c in LEDGER)
+    departed = sum(thermo.get(c, np.zeros_like(kinetic)) for c in DEPARTED)
     budget = dict(kinetic=kinetic, potential=thermo["PotEng"], dissipated=dissipated,
-                  total=kinetic + thermo["PotEng"] + dissipated)
+                  total=kinetic + thermo["PotEng"] + dissipated, departed=departed)
     budget.update({name: thermo[c] for name, c in zip(CHANNELS, LEDGER)})
     return budget
 
