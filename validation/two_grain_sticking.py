@@ -66,7 +66,7 @@ def sticks(v_col: float, tvis: float, where: Path) -> bool:
         run.run_until_settled(progress=False)
         if run.stop_reason != "settled":
             raise RuntimeError(f"v_col = {v_col} m/s, T_vis = {tvis} s: {run.stop_reason}")
-        return run.thermo()[ledger.THERMO[-1]][-1] > 0
+        return run.thermo()[ledger.CONTACTS][-1] > 0
 
 
 def threshold(tvis: float, width: float, where: Path) -> tuple[float, float | None, int]:
