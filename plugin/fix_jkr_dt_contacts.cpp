@@ -28,7 +28,8 @@ FixJKRDTContacts::FixJKRDTContacts(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), npartner(nullptr), partner(nullptr), values(nullptr), ledger(nullptr),
     owner(nullptr), dnum(0), bonded(nullptr), slot_values(nullptr), slot_first(nullptr),
     natoms_at_run_end(0), mask(0), maxpartner(INITIAL_CAPACITY), nmax_alloc(0),
-    maxslot(0), slot_dnum(0), maxfirst(0), slot_list(nullptr), slot_build(-1), rows_stale(false)
+    maxslot(0), slot_dnum(0), maxfirst(0), slot_list(nullptr), slot_build(-1), rows_stale(false),
+    slot_nlocal(0)
 {
   if (narg != 4)
     error->all(FLERR,
@@ -44,6 +45,11 @@ FixJKRDTContacts::FixJKRDTContacts(LAMMPS *lmp, int narg, char **arg) :
   scalar_flag = 1;
   global_freq = 1;
   extscalar = 0;
+
+  // an atom's exchange record grows with its contacts: Comm and Irregular size their
+  // buffers from maxexchange, which set_exchange_size() keeps at the largest record
+  maxexchange_dynamic = 1;
+  set_exchange_size();
 
   grow_arrays(atom->nmax);
   atom->add_callback(Atom::GROW);
@@ -230,6 +236,7 @@ void FixJKRDTContacts::set_layout(int newmask)
   mask = newmask;
   dnum = newdnum;
   std::copy_n(newoffset, NFIELD, field_offset);
+  set_exchange_size();
 }
 
 int FixJKRDTContacts::setmask()
@@ -321,6 +328,11 @@ void FixJKRDTContacts::to_slots(NeighList *list)
     }
   slot_list = list;
   slot_build = neighbor->lastcall;
+  // the atoms as the list saw them: a fix that migrates atoms before this fix's
+  // pre_exchange (fix balance rcb) may append arrivals, which take the ghosts' places,
+  // before the rows are written back
+  slot_nlocal = nlocal;
+  slot_tag.assign(tag, tag + nlocal + atom->nghost);
 }
 
 /* ----------------------------------------------------------------------
@@ -332,8 +344,13 @@ void FixJKRDTContacts::to_rows()
   if (!rows_stale) return;
   rows_stale = false;
   const NeighList *list = slot_list;
-  const int nlocal = atom->nlocal;
-  const tagint *tag = atom->tag;
+  // the atoms the list was built over; atoms appended since (arrived from another rank
+  // while this rank sent none) brought their rows with them and are left alone
+  const int nlocal = slot_nlocal;
+  if (atom->nlocal < nlocal)
+    error->one(FLERR, "pair jkr/dt: atoms left this rank before their contacts were written "
+                      "back (internal error)");
+  const tagint *tag = slot_tag.data();
   for (int i = 0; i < nlocal; i++) npartner[i] = 0;
   for (int ii = 0; ii < list->inum; ii++) {
     const int i = list->ilist[ii];
@@ -409,6 +426,14 @@ void FixJKRDTContacts::grow_partner_capacity(int needed)
   partner = newpartner;
   values = newvalues;
   maxpartner = newmax;
+  set_exchange_size();
+}
+
+// doubles of the largest exchange record (pack_exchange): count, partner IDs, values,
+// ledger, owner ID
+void FixJKRDTContacts::set_exchange_size()
+{
+  maxexchange = 2 + NLEDGER + maxpartner * (1 + dnum);
 }
 
 /* ----------------------------------------------------------------------

@@ -139,11 +139,14 @@ class FixJKRDTContacts : public Fix {
   int nmax_alloc;       // rows allocated in the per-atom arrays
 
   void grow_partner_capacity(int needed);
+  void set_exchange_size();
   int maxslot, slot_dnum;           // slots allocated, values per allocated slot
   int maxfirst;                     // ilist entries allocated
   const class NeighList *slot_list; // the list the slots follow ...
   bigint slot_build;                // ... as built at this step (neighbor->lastcall)
   bool rows_stale;                  // the slots hold state the rows do not
+  int slot_nlocal;                  // owned atoms when the slots were filled ...
+  std::vector<tagint> slot_tag;     // ... and the IDs of all atoms then, owned and ghost
   static int layout_size(int mask, int *offsets);
 };
 
