@@ -167,7 +167,10 @@ bigint FixJKRDTContacts::count() const
   return all / 2;    // each contact is stored with both of its atoms
 }
 
-std::vector<tagint> FixJKRDTContacts::gather(const std::vector<tagint> &mine, MPI_Comm world)
+namespace {
+// the concatenation of every rank's values, in rank order, on every rank
+template <typename T>
+std::vector<T> gather_all(const std::vector<T> &mine, MPI_Datatype type, MPI_Comm world)
 {
   int nprocs = 1;
   MPI_Comm_size(world, &nprocs);
@@ -175,10 +178,20 @@ std::vector<tagint> FixJKRDTContacts::gather(const std::vector<tagint> &mine, MP
   std::vector<int> counts(nprocs), displs(nprocs, 0);
   MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, world);
   for (int r = 1; r < nprocs; r++) displs[r] = displs[r - 1] + counts[r - 1];
-  std::vector<tagint> all(displs.back() + counts.back());
-  MPI_Allgatherv(mine.data(), n, MPI_LMP_TAGINT, all.data(), counts.data(), displs.data(),
-                 MPI_LMP_TAGINT, world);
+  std::vector<T> all(displs.back() + counts.back());
+  MPI_Allgatherv(mine.data(), n, type, all.data(), counts.data(), displs.data(), type, world);
   return all;
+}
+}    // namespace
+
+std::vector<tagint> FixJKRDTContacts::gather(const std::vector<tagint> &mine, MPI_Comm world)
+{
+  return gather_all(mine, MPI_LMP_TAGINT, world);
+}
+
+std::vector<double> FixJKRDTContacts::gather(const std::vector<double> &mine, MPI_Comm world)
+{
+  return gather_all(mine, MPI_DOUBLE, world);
 }
 
 /* ----------------------------------------------------------------------

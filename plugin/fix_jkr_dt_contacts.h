@@ -79,6 +79,7 @@ class FixJKRDTContacts : public Fix {
   bigint count() const;    // bonded contacts over all ranks (collective)
   // the concatenation of every rank's ``mine``, in rank order, on every rank (collective)
   static std::vector<tagint> gather(const std::vector<tagint> &mine, MPI_Comm world);
+  static std::vector<double> gather(const std::vector<double> &mine, MPI_Comm world);
   void post_run() override;
   double compute_scalar() override { return dnum; }    // doubles stored per contact
 

@@ -21,8 +21,9 @@
      growing at u_j
 
    (the second lets a small fragment leave a hot remnant: its bound grains
-   stay inside it, and its fast free ones fly elsewhere). never_meet() is the exact least distance of a point and a
-   growing sphere on straight lines. The rule is exact for bodies that are
+   stay inside it, and its fast free ones fly elsewhere). never_meet() is
+   the exact least distance of a point and a growing sphere on straight
+   lines. The rule is exact for bodies that are
    rigid or slower inside than u; it can be wrong when a fragment heats up
    after the check (a later collision inside it). How often, is measured
    with depart shadow against runs that keep every fragment moving
@@ -36,16 +37,12 @@
 #include "atom.h"
 #include "comm.h"
 #include "domain.h"
-#include "error.h"
 #include "force.h"
-#include "group.h"
-#include "modify.h"
 #include "update.h"
 #include "utils.h"
 
 #include <algorithm>
 #include <cmath>
-#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -99,21 +96,6 @@ bool never_meet(const double p[3], const double q[3], double reach, double u)
   const double root = std::sqrt(1.0 - k * k);
   if (-k * b / root > a) return true;    // the least is now: they only draw apart
   return b * root - k * a > reach;
-}
-
-// the concatenation of every rank's values, in rank order, on every rank
-std::vector<double> gather_doubles(const std::vector<double> &mine, MPI_Comm world)
-{
-  int nprocs;
-  MPI_Comm_size(world, &nprocs);
-  const int n = static_cast<int>(mine.size());
-  std::vector<int> counts(nprocs), displs(nprocs, 0);
-  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, world);
-  for (int r = 1; r < nprocs; r++) displs[r] = displs[r - 1] + counts[r - 1];
-  std::vector<double> all(displs[nprocs - 1] + counts[nprocs - 1]);
-  MPI_Allgatherv(mine.data(), n, MPI_DOUBLE, all.data(), counts.data(), displs.data(),
-                 MPI_DOUBLE, world);
-  return all;
 }
 
 }    // namespace
@@ -223,7 +205,8 @@ void FixJKRDTSettle::find_departures(Graph &graph)
       const double d = v[i][k] - B[b].V[k] - rigid[k];
       u2 += d * d;
     }
-    ext[2 * b] = std::max(ext[2 * b], std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]) + radius[i]);
+    const double reach = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]) + radius[i];
+    ext[2 * b] = std::max(ext[2 * b], reach);
     ext[2 * b + 1] = std::max(ext[2 * b + 1], std::sqrt(u2));
     internal_speed2[i] = u2;
   }
@@ -248,7 +231,7 @@ void FixJKRDTSettle::find_departures(Graph &graph)
     mine_grains.insert(mine_grains.end(),
                        {(double) b, x[0], x[1], x[2], v[i][0], v[i][1], v[i][2], radius[i]});
   }
-  const std::vector<double> grains_raw = gather_doubles(mine_grains, world);
+  const std::vector<double> grains_raw = FixJKRDTContacts::gather(mine_grains, world);
   std::vector<int> first_grain(M + 1, 0);
   for (size_t k = 0; k < grains_raw.size(); k += 8) first_grain[(int) grains_raw[k] + 1]++;
   for (int b = 0; b < M; b++) first_grain[b + 1] += first_grain[b];
@@ -260,7 +243,7 @@ void FixJKRDTSettle::find_departures(Graph &graph)
   }
 
   // single grains of every rank, in rank order
-  const std::vector<double> singles = gather_doubles(single, world);
+  const std::vector<double> singles = FixJKRDTContacts::gather(single, world);
   double rmax = 0.0;
   for (int i = 0; i < nlocal; i++) rmax = std::max(rmax, radius[i]);
   double rmax_all;
@@ -365,6 +348,8 @@ void FixJKRDTSettle::find_departures(Graph &graph)
   }
   next_reneighbor = update->ntimestep + 1;
   if (comm->me == 0)
-    utils::logmesg(lmp, "jkr/dt/settle: departed step {} fragments {} grains {} (so far {} fragments, {} grains)\n",
+    utils::logmesg(lmp,
+                   "jkr/dt/settle: departed step {} fragments {} grains {} (so far {} "
+                   "fragments, {} grains)\n",
                    update->ntimestep, n_frag, n_grains, departed_fragments, departed_grains);
 }

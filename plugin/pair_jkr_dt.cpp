@@ -378,9 +378,11 @@ void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, A
 
       // a grain of a fragment that has left for good meets nothing, and its own contacts
       // stand still: they are only evaluated, as a set-up does, for their potential energy
+      const bool p_own = p < nlocal, q_own = q < nlocal;
+      const double share = 0.5 * ((p_own ? 1.0 : 0.0) + (q_own ? 1.0 : 0.0));
       const bool parked = departed && ((mask[p] | mask[q]) & departed);
       if (parked && !(bonded && eflag)) {
-        if (bonded) acc.contacts += 0.5 * ((p < nlocal ? 1.0 : 0.0) + (q < nlocal ? 1.0 : 0.0));
+        if (bonded) acc.contacts += share;
         continue;
       }
       const bool setup = run_setup || parked;
@@ -428,7 +430,6 @@ void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, A
 
       double *state = layout.dnum ? slot_values + (bigint) s * layout.dnum : nullptr;
       JKRDT::contact_step(K, layout, m, delta, dt, setup, formed, eflag, state, out);
-      const bool p_own = p < nlocal, q_own = q < nlocal;
       const bool p_mine = p_own && (!thread_of_atom || thread_of_atom[p] == me);
       const bool q_mine = q_own && (!thread_of_atom || thread_of_atom[q] == me);
       const V3 &fp = out.F1;
@@ -470,7 +471,6 @@ void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, A
         ta[2] += side.m.z;
       }
       if (out.broken) continue;
-      const double share = 0.5 * ((p_own ? 1.0 : 0.0) + (q_own ? 1.0 : 0.0));
       acc.contacts += share;
       if (!eflag && !vflag_either) continue;
       const double u = out.U_n + out.U[0] + out.U[1] + out.U[2];

@@ -23,7 +23,7 @@ def run_campaigns(specs: dict[str, dict], runs: Path, ranks: int) -> dict[str, P
     runs.mkdir(parents=True, exist_ok=True)
     where = campaign_paths(specs, runs)
     for name, spec in specs.items():
-        path = where[name].with_suffix(".json")
+        path = runs / f"{where[name].name}.json"
         path.write_text(json.dumps(spec))
         cmd = [str(BIN / "jkrdt"), "campaign", str(path), str(where[name]), "--quiet"]
         if ranks > 1:

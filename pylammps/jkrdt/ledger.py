@@ -10,9 +10,11 @@ The plugin's compute gives 10 values (its manual page, "Output"):
 
 ke + erotate/sphere + pe + values 5-9 is conserved. The deck's computes kedep and erotdep
 are the part of ke and erotate that fragments which have departed (``jkrdt.stopping``)
-carry away: constant once they are gone, like their contacts' share of pe. This module is the one place that
-layout is written down: the deck's thermo line (``inputs/collision.lmp``, tested to
-match ``THERMO_STYLE``), ``Session``'s samples and the analysis of a log read it from here.
+carry away: constant once they are gone, like their contacts' share of pe.
+
+This module is the one place that layout is written down: the deck's thermo line
+(``inputs/collision.lmp``, tested to match ``THERMO_STYLE``), ``Session``'s samples and
+the analysis of a log read it from here.
 """
 
 from __future__ import annotations

@@ -18,7 +18,9 @@ At each check, fragments that have left the collision for good depart (``depart`
 "Fragments that fly apart"): they keep their velocities, spins and contacts but stop
 and meet nothing more, so the box, the neighbor bins and the cost per step stop growing
 with them. "no" lets every fragment fly; "shadow" lets them fly and logs, once per
-fragment, when the rule would have let it depart (to measure the rule). The defaults below check every 50 t_c over 5 checks (250 t_c, about
+fragment, when the rule would have let it depart (to measure the rule).
+
+The defaults below check every 50 t_c over 5 checks (250 t_c, about
 70 ns for 0.1 micron ice), which is longer than a grain's contact time and shorter
 than a collision of a few hundred grains.
 
