@@ -4,8 +4,9 @@
                                         [--out benchmarks/results/builders.json]
 
 Timings (one core, seconds and microseconds per grain):
-  BPCA 3D and 2D, N = 10^3 ... --max-bpca, with the kd-tree neighbour search, and the
-  reference in the same run: the same builder testing every grain (kd-tree off), up to 10^4;
+  BPCA 3D and 2D, N = 10^3 ... --max-bpca (the grid, 64 lines at a time), and the
+  reference in the same run: the plain process (one line at a time against every
+  grain, ``bpca_plain``), up to 10^4;
   BCCA 3D and 2D, N = 2^10 ... --max-bcca.
 Structure: fits of N = k0 (r_g/r_1)^D_f over ensembles (Wada et al. 2007, eqs. 52-53),
 for 2D BCCA to compare with eq. 53 (D_f 1.57, k0 1.37), for 3D BCCA (D_f ~ 1.9) and BPCA.
@@ -21,24 +22,18 @@ from pathlib import Path
 
 import numpy as np
 
-from jkrdt import aggregates
-from jkrdt.aggregates import bcca, bpca, fractal_fit, gyration_radius
+from jkrdt.aggregates import bcca, bpca, bpca_plain, fractal_fit, gyration_radius
 from jkrdt.materials import ICE, scales
 
 R = 1.0e-7
 DELTA0 = scales(ICE, R).delta0
 
 
-def timed(build, n, dim, seed=1, kd_tree=True):
-    saved = aggregates.KD_TREE_FROM
-    aggregates.KD_TREE_FROM = saved if kd_tree else n + 1
-    try:
-        t0 = time.perf_counter()
-        x = build(n, R, DELTA0, np.random.default_rng(seed), dim=dim)
-        seconds = time.perf_counter() - t0
-    finally:
-        aggregates.KD_TREE_FROM = saved
-    return dict(N=n, dim=dim, kd_tree=kd_tree, seconds=seconds, us_per_grain=1e6 * seconds / n,
+def timed(build, n, dim, seed=1):
+    t0 = time.perf_counter()
+    x = build(n, R, DELTA0, np.random.default_rng(seed), dim=dim)
+    seconds = time.perf_counter() - t0
+    return dict(N=n, dim=dim, seconds=seconds, us_per_grain=1e6 * seconds / n,
                 rg_over_r=gyration_radius(x) / R)
 
 
@@ -62,12 +57,12 @@ def main(argv=None):
 
     timings = []
     for dim in (3, 2):
-        for n in [1000, 3000, 10000, 30000, 100000]:
+        for n in [1000, 3000, 10000, 30000, 50000, 100000]:
             if n <= args.max_bpca:
                 timings.append(dict(builder="bpca", **timed(bpca, n, dim)))
                 print(timings[-1], flush=True)
             if n <= 10000:
-                timings.append(dict(builder="bpca", **timed(bpca, n, dim, kd_tree=False)))
+                timings.append(dict(builder="bpca_plain", **timed(bpca_plain, n, dim)))
                 print(timings[-1], flush=True)
         for k in range(10, 18, 2 if args.max_bcca > 2 ** 14 else 1):
             if 2 ** k <= args.max_bcca:

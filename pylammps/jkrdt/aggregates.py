@@ -9,6 +9,9 @@ Reproducible from a ``numpy.random.Generator``.
 
 from __future__ import annotations
 
+import itertools
+import math
+
 import numpy as np
 from scipy.spatial import cKDTree
 
@@ -28,38 +31,85 @@ def random_directions(rng: np.random.Generator, n: int, dim: int) -> np.ndarray:
     return v / np.linalg.norm(v, axis=1, keepdims=True)
 
 
-#: BPCA size from which neighbour queries go through a kd-tree (below, all grains are tested)
-KD_TREE_FROM = 2048
+class _RayGrid:
+    """Positions of a growing cluster, binned for straight-line queries.
 
+    Cells are cubes of side ``cell``. Each grain is listed in every cell that its
+    sphere of radius ``reach`` (the contact distance plus half the ray sampling step)
+    overlaps, so the grains within contact of a ray are all listed in the cells of
+    the ray's sample points, and those within contact of a point in that point's
+    cell. The grid doubles when the cluster reaches its edge; a cell's slots double
+    when one fills.
+    """
 
-class _GrowingSet:
-    """Positions of a growing cluster with neighbour queries: a kd-tree rebuilt
-    every 256 grains, plus the grains added since."""
-
-    def __init__(self, capacity: int):
+    def __init__(self, capacity: int, reach: float):
         self.x = np.zeros((capacity, 3))
         self.n = 0
-        self.tree, self.n_tree = None, 0
+        self.reach = reach
+        self.cell = 2.0 * reach                 # a grain is then listed in at most 8 cells
+        self._allocate(16, 8)
 
-    def add(self, p):
+    def _allocate(self, side: int, slots: int) -> None:
+        self.side = side
+        self.low = -0.5 * side * self.cell      # the cluster grows about the origin
+        self.slots = np.full((side ** 3, slots), -1, dtype=np.int64)
+        self.count = np.zeros(side ** 3, dtype=np.int64)
+
+    def _cells_of(self, p) -> list[int] | None:
+        """The cells that a sphere of radius ``reach`` at ``p`` overlaps (None: off the grid)."""
+        ranges = []
+        for c in p:
+            lo = math.floor((c - self.reach - self.low) / self.cell)
+            hi = math.floor((c + self.reach - self.low) / self.cell)
+            if lo < 0 or hi >= self.side:
+                return None
+            ranges.append(range(lo, hi + 1))
+        return [(i * self.side + j) * self.side + k for i, j, k in itertools.product(*ranges)]
+
+    def _list(self, k: int) -> bool:
+        cells = self._cells_of(self.x[k])
+        if cells is None:
+            return False
+        for c in cells:
+            if self.count[c] == self.slots.shape[1]:
+                self.slots = np.hstack([self.slots, np.full_like(self.slots, -1)])
+            self.slots[c, self.count[c]] = k
+            self.count[c] += 1
+        return True
+
+    def add(self, p) -> None:
         self.x[self.n] = p
         self.n += 1
-        if self.n >= self.n_tree + 256:
-            self.tree, self.n_tree = cKDTree(self.x[:self.n]), self.n
+        side = self.side
+        while not self._list(self.n - 1):        # off the grid: a grid twice as wide
+            side *= 2
+            self._allocate(side, self.slots.shape[1])
+            for k in range(self.n - 1):
+                self._list(k)
 
-    def near(self, points: np.ndarray, distance: float) -> np.ndarray:
-        """Indices of the grains within ``distance`` of any of ``points``; while the
-        cluster is small, all of them (the caller tests exactly)."""
-        if self.n < KD_TREE_FROM:
-            return np.arange(self.n)
-        found = []
-        if self.tree is not None:
-            hits = self.tree.query_ball_point(points, distance)
-            found = [np.concatenate([np.asarray(h, dtype=int) for h in hits])]
-        recent = self.x[self.n_tree:self.n]
-        d2 = ((recent[None, :, :] - points[:, None, :]) ** 2).sum(axis=2)
-        found.append(self.n_tree + np.flatnonzero((d2 < distance ** 2).any(axis=0)))
-        return np.unique(np.concatenate(found))
+    def near(self, p) -> np.ndarray:
+        """The grains within ``reach`` of the point ``p``, and some farther."""
+        i, j, k = (math.floor((c - self.low) / self.cell) for c in p)
+        row = self.slots[(i * self.side + j) * self.side + k]
+        return row[row >= 0]
+
+    def listed(self, points: np.ndarray, groups: np.ndarray | None = None):
+        """Grain indices listed in the cells of ``points`` (m, 3), with repeats; with
+        ``groups`` (m,), also the group of the point each was found from."""
+        idx = np.floor((points - self.low) / self.cell).astype(np.int64)
+        inside = ((idx >= 0) & (idx < self.side)).all(axis=1)
+        cells = (idx[inside, 0] * self.side + idx[inside, 1]) * self.side + idx[inside, 2]
+        if groups is None:
+            found = self.slots[np.unique(cells)]
+            return found[found >= 0]
+        key = np.unique(groups[inside] * self.side ** 3 + cells)
+        found = self.slots[key % self.side ** 3]
+        keep = found >= 0
+        return found[keep], np.broadcast_to((key // self.side ** 3)[:, None], found.shape)[keep]
+
+
+#: lines thrown at once: their first touches are found together, then taken in turn
+BPCA_LINES = 64
 
 
 def bpca(n: int, radius: float, delta0: float, rng: np.random.Generator, dim: int = 3,
@@ -69,58 +119,107 @@ def bpca(n: int, radius: float, delta0: float, rng: np.random.Generator, dim: in
     Each new grain comes from a random direction along a straight line with a
     random offset inside a disc (3D) or segment (2D) that covers the cluster,
     and sticks where it first touches; it is then pulled onto the bond length
-    2 r - delta0. A grain that would touch a second one there is thrown again.
-    Beyond 2048 grains, grains near the line are found with a kd-tree, so a
-    grain costs about O(log N) plus its path through the cluster, not O(N).
+    2 r - delta0. A grain that would touch a second one there, and a line that
+    misses, is thrown again. Since lines that miss are thrown again, the
+    covering disc's size and centre do not change the aggregate's statistics,
+    which lets ``BPCA_LINES`` lines be thrown at once from one disc: their first
+    touches with the cluster are found together in a grid (``_RayGrid``), then
+    the lines are taken in turn, each grain that sticks updating the first
+    touches of the lines after it. A grain costs a few array operations, not O(N).
     """
     if n < 1:
         raise ValueError("an aggregate needs n >= 1 grains")
     _check(dim, radius, delta0)
     contact = 2.0 * radius
     bond = contact - delta0
-    grains = _GrowingSet(n)
+    step = radius                                 # sampling step along a line
+    grains = _RayGrid(n, contact + 0.5 * step)
     grains.add(np.zeros(3))
     total = np.zeros(3)          # sum of positions, for the centre of mass
-    reach = 0.0                  # bound on the distance of any grain from the centre
-    for k in range(1, n):
+    k, thrown = 1, 0
+    while k < n:
         centre = total / k
-        span = reach + contact
-        for _ in range(max_tries):
-            u = random_directions(rng, 1, dim)[0]
-            w = random_directions(rng, 1, dim)[0]
-            w -= (w @ u) * u
-            w /= np.linalg.norm(w)
-            spread = span * (np.sqrt(rng.random()) if dim == 3 else 2 * rng.random() - 1)
-            start = centre - span * u + spread * w
-            # grains within 2r of the path: near samples every 2r along it (cover 2.24 r)
-            samples = start + np.outer(np.arange(0.0, 2 * span + contact, contact), u)
-            cand = grains.near(samples, 1.125 * contact)
-            if cand.size == 0:
+        reach = float(np.sqrt(((grains.x[:k] - centre) ** 2).sum(axis=1).max()))
+        span = reach + contact                    # the disc's radius: it covers the cluster
+        u = random_directions(rng, 2 * BPCA_LINES, dim)
+        u, w = u[:BPCA_LINES], u[BPCA_LINES:]
+        w -= (w * u).sum(axis=1, keepdims=True) * u
+        w /= np.linalg.norm(w, axis=1, keepdims=True)
+        r = rng.random(BPCA_LINES)
+        spread = span * (np.sqrt(r) if dim == 3 else 2 * r - 1)
+        starts = centre - span * u + spread[:, None] * w
+        # the first touch of each line with the cluster as it is: grains near the line
+        # are those listed in the cells of its points, every ``step`` along it
+        offsets = np.arange(0.0, 2 * span + contact, step)
+        points = (starts[:, None, :] + offsets[None, :, None] * u[:, None, :]).reshape(-1, 3)
+        cand, line = grains.listed(points, np.repeat(np.arange(BPCA_LINES), len(offsets)))
+        rel = starts[line] - grains.x[cand]
+        b = (rel * u[line]).sum(axis=1)
+        disc = b * b - ((rel ** 2).sum(axis=1) - contact ** 2)
+        hit = disc >= 0
+        cand, line = cand[hit], line[hit]
+        t = np.full(BPCA_LINES, np.inf)
+        target = np.zeros(BPCA_LINES, dtype=np.int64)
+        along = -b[hit] - np.sqrt(disc[hit])
+        order = np.lexsort((along, line))
+        hitting, first = np.unique(line[order], return_index=True)
+        t[hitting], target[hitting] = along[order[first]], cand[order[first]]
+        for j in range(BPCA_LINES):
+            thrown += 1
+            if thrown > max_tries:
+                raise RuntimeError(f"BPCA: could not place grain {k} in {max_tries} tries")
+            if not np.isfinite(t[j]):
                 continue
-            rel = start - grains.x[cand]
-            b = rel @ u
-            disc = b * b - ((rel ** 2).sum(axis=1) - contact ** 2)
-            hit = disc >= 0
-            if not hit.any():
-                continue
-            t = -b[hit] - np.sqrt(disc[hit])
-            target = cand[hit][np.argmin(t)]
-            touch = start + t.min() * u
-            new = grains.x[target] + (touch - grains.x[target]) * (bond / contact)
-            near = grains.near(new[None, :], contact)
-            gaps = np.linalg.norm(grains.x[near] - new, axis=1)
-            if np.array_equal(near[gaps <= contact], [target]):
-                break
-        else:
-            raise RuntimeError(f"BPCA: could not place grain {k} in {max_tries} tries")
-        grains.add(new)
-        total += new
-        moved = total / (k + 1)
-        # the old grains are at most reach + |shift of the centre| from the new centre
-        reach = max(reach + np.linalg.norm(moved - centre), np.linalg.norm(new - moved))
-        if k % 256 == 0:
-            reach = float(np.sqrt(((grains.x[:k + 1] - moved) ** 2).sum(axis=1).max()))
+            x_t = grains.x[target[j]]
+            new = x_t + (starts[j] + t[j] * u[j] - x_t) * (bond / contact)
+            near = grains.near(new)
+            gaps = ((grains.x[near] - new) ** 2).sum(axis=1)
+            if np.count_nonzero(near[gaps <= contact ** 2] != target[j]):
+                continue          # it would touch a second grain
+            grains.add(new)
+            total += new
+            k, thrown = k + 1, 0
+            if k == n or math.dist(new, centre) + contact > span:
+                break             # done, or the disc no longer covers the cluster
+            # the new grain may come first on the lines still to be taken
+            rel = starts[j + 1:] - new
+            b_new = (rel * u[j + 1:]).sum(axis=1)
+            disc_new = b_new * b_new - ((rel ** 2).sum(axis=1) - contact ** 2)
+            with np.errstate(invalid="ignore"):
+                t_new = -b_new - np.sqrt(disc_new)
+            sooner = t_new < t[j + 1:]                  # False where it misses (NaN)
+            t[j + 1:][sooner] = t_new[sooner]
+            target[j + 1:][sooner] = k - 1
     x = grains.x[:n]
+    return x - x.mean(axis=0)
+
+
+def bpca_plain(n: int, radius: float, delta0: float, rng: np.random.Generator,
+               dim: int = 3) -> np.ndarray:
+    """BPCA as the papers define it, in its plainest form: one line at a time from a
+    disc covering the cluster, its first touch found against every grain, O(N^2).
+    The reference that ``bpca`` is tested and timed against."""
+    _check(dim, radius, delta0)
+    contact, bond = 2.0 * radius, 2.0 * radius - delta0
+    x = np.zeros((1, 3))
+    while len(x) < n:
+        centre = x.mean(axis=0)
+        span = np.sqrt(((x - centre) ** 2).sum(axis=1).max()) + contact
+        u, w = random_directions(rng, 2, dim)
+        w -= (w @ u) * u
+        w /= np.linalg.norm(w)
+        r = rng.random()
+        start = centre - span * u + span * (np.sqrt(r) if dim == 3 else 2 * r - 1) * w
+        rel = start - x
+        b = rel @ u
+        disc = b * b - ((rel ** 2).sum(axis=1) - contact ** 2)
+        if not (disc >= 0).any():
+            continue
+        t = np.where(disc >= 0, -b - np.sqrt(np.abs(disc)), np.inf)
+        k = np.argmin(t)
+        new = x[k] + (start + t[k] * u - x[k]) * (bond / contact)
+        if np.count_nonzero(np.linalg.norm(x - new, axis=1) <= contact) == 1:
+            x = np.vstack([x, new])
     return x - x.mean(axis=0)
 
 
@@ -153,6 +252,20 @@ def _pairs_within(a: np.ndarray, b: np.ndarray, distance: float):
     return m.row[keep], m.col[keep], m.data[keep]
 
 
+def first_touch_along_x(a: np.ndarray, b: np.ndarray, distance: float):
+    """Cluster ``b`` coming in along -x from far away towards cluster ``a``: the shift
+    L along x at which a grain of b (moved by +L) first comes within ``distance`` of
+    a grain of a, and that pair (L, i, j); None if no path crosses."""
+    # grains whose paths cross: projections on the plane normal to x closer than distance
+    i, j, rho = _pairs_within(a[:, 1:], b[:, 1:], distance)
+    if i.size == 0:
+        return None
+    # b shifted by +L is at distance from pair (i, j) at L_ij; from +infinity the first is the largest
+    shift = a[i, 0] - b[j, 0] + np.sqrt(distance ** 2 - rho ** 2)
+    k = int(np.argmax(shift))
+    return float(shift[k]), int(i[k]), int(j[k])
+
+
 def stick_head_on(a: np.ndarray, b: np.ndarray, radius: float, delta0: float,
                   rng: np.random.Generator, dim: int = 3, max_tries: int = 1000) -> np.ndarray:
     """Stick cluster ``b`` onto cluster ``a``, head-on (Wada et al. 2007, sec. 4).
@@ -167,15 +280,12 @@ def stick_head_on(a: np.ndarray, b: np.ndarray, radius: float, delta0: float,
     for _ in range(max_tries):
         pa = (a - a.mean(axis=0)) @ random_rotation(rng, dim).T
         pb = (b - b.mean(axis=0)) @ random_rotation(rng, dim).T
-        # grains whose paths cross: projections on the plane normal to x closer than 2r
-        i, j, rho = _pairs_within(pa[:, 1:], pb[:, 1:], contact)
-        if i.size == 0:
+        touch = first_touch_along_x(pa, pb, contact)
+        if touch is None:
             continue
-        # b shifted by +L touches pair (i, j) at L_ij; coming from +infinity the first is the largest
-        reach = pa[i, 0] - pb[j, 0] + np.sqrt(contact ** 2 - rho ** 2)
-        k = int(np.argmax(reach))
-        pb[:, 0] += reach[k]
-        normal = (pb[j[k]] - pa[i[k]]) / contact
+        shift, i, j = touch
+        pb[:, 0] += shift
+        normal = (pb[j] - pa[i]) / contact
         pb -= delta0 * normal                   # the bond sits at 2 r - delta0
         if cKDTree(pa).count_neighbors(cKDTree(pb), contact) == 1:
             merged = np.vstack([pa, pb])

@@ -12,9 +12,7 @@ import dataclasses
 import math
 
 import numpy as np
-from scipy.spatial import cKDTree
-
-from .aggregates import gyration_radius, random_rotation
+from .aggregates import first_touch_along_x, gyration_radius, random_rotation
 
 
 @dataclasses.dataclass
@@ -49,31 +47,11 @@ def set_up(target: np.ndarray, projectile: np.ndarray, radius: float, v_col: flo
     pro -= pro.mean(axis=0)
     b = b_off * (characteristic_radius(tar) + characteristic_radius(pro))
     lateral = np.array([0.0, b, 0.0])
-    tree = cKDTree(tar)
-    contact = 2.0 * radius
-
-    def nearest(shift):
-        d, _ = tree.query(pro + lateral + [shift, 0.0, 0.0])
-        return d.min()
-
-    # slide in from far away: bisection on the x shift for nearest = contact + gap
-    far = np.ptp(tar[:, 0]) + np.ptp(pro[:, 0]) + 4 * contact
-    lo, hi = -far, far
-    if nearest(hi) < contact + gap:
-        raise RuntimeError("collision set-up: could not separate the aggregates")
-    # walk down from hi in steps of one radius to the first approach, then bisect
-    step = radius
-    x_shift = hi
-    while x_shift > lo and nearest(x_shift - step) > contact + gap:
-        x_shift -= step
-    lo_b, hi_b = x_shift - step, x_shift
-    for _ in range(60):
-        mid = 0.5 * (lo_b + hi_b)
-        if nearest(mid) > contact + gap:
-            hi_b = mid
-        else:
-            lo_b = mid
-    pro = pro + lateral + [hi_b, 0.0, 0.0]
+    # slide in along -x until the nearest pair is contact + gap apart
+    # (no path crosses at a grazing B_off: the projectile flies by, starting level with the target)
+    touch = first_touch_along_x(tar, pro + lateral, 2.0 * radius + gap)
+    shift = touch[0] if touch else tar[:, 0].max() - pro[:, 0].min() + 2.0 * radius + gap
+    pro = pro + lateral + [shift, 0.0, 0.0]
 
     n_tar, n_pro = len(tar), len(pro)
     n_tot = n_tar + n_pro
