@@ -1,12 +1,13 @@
-"""Reading a run's dumps, one frame at a time.
+"""Reading a run's dumps, one frame at a time, plain or compressed (``.gz``, as the scene
+deck writes them).
 
-* ``atoms.dump`` (``dump custom ... id type radius x y z vx vy vz c_coord
+* ``atoms.dump.gz`` (``dump custom ... id type radius x y z vx vy vz c_coord
   d_departed_at``: the last, the time a grain's fragment departed, 0 if it did not) is read
   with MDAnalysis' LAMMPSDUMP reader; the extra per-atom columns (radius, the
   coordination c_coord, ...) come with each frame. MDAnalysis keeps positions in
   float32 and shifts them so that the box starts at 0: distances are good to about
   1e-7 of the box size (1e-13 m for a micron box, far below delta_c).
-* ``contacts.dump`` (``dump local ... c_bonds[*]`` of compute jkr/dt/contacts:
+* ``contacts.dump.gz`` (``dump local ... c_bonds[*]`` of compute jkr/dt/contacts:
   id1 id2 delta a force |zeta| |xi| |phi|) has no MDAnalysis reader; it is read here
   as a stream of snapshots.
 
@@ -16,11 +17,15 @@ Both are generators: a long trajectory is never held in memory at once.
 from __future__ import annotations
 
 import dataclasses
+import gzip
+import tempfile
 import warnings
 from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
+
+from jkrdt.scene import ATOMS, CONTACTS
 
 #: columns of compute jkr/dt/contacts, in the order of the local dump
 CONTACT_COLUMNS = ["id1", "id2", "delta", "a", "force", "zeta", "xi", "phi"]
@@ -36,7 +41,7 @@ def atoms_universe(path, columns=("radius", "c_coord", DEPARTED_AT)):
     import MDAnalysis as mda
 
     path = Path(path)
-    with path.open() as f:
+    with open_text(path) as f:
         header = next((line for line in f if line.startswith("ITEM: ATOMS")), None)
     if header is None:
         raise ValueError(f"{path}: not a LAMMPS dump (no 'ITEM: ATOMS' line)")
@@ -49,8 +54,33 @@ def atoms_universe(path, columns=("radius", "c_coord", DEPARTED_AT)):
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", message="Guessed all Masses")
         warnings.filterwarnings("ignore", message="Reader has no dt information")
-        return mda.Universe(str(path), format="LAMMPSDUMP", topology_format="LAMMPSDUMP",
-                            additional_columns=extra, dt=1.0)
+        try:
+            return mda.Universe(str(path), format="LAMMPSDUMP", topology_format="LAMMPSDUMP",
+                                additional_columns=extra, dt=1.0)
+        except EOFError:
+            readable = _readable_part(path)
+            return mda.Universe(str(readable), format="LAMMPSDUMP",
+                                topology_format="LAMMPSDUMP", additional_columns=extra, dt=1.0)
+
+
+def _readable_part(path: Path) -> Path:
+    """A compressed dump that a kill left without its end, as far as it can be read, in a
+    plain temporary file (MDAnalysis drops its cut-off last frame)."""
+    part = tempfile.NamedTemporaryFile("w", prefix=path.name + ".", suffix=".readable",
+                                       delete=False)
+    with part, gzip.open(path, "rt") as f:
+        try:
+            for line in f:
+                part.write(line)
+        except EOFError:
+            pass
+    return Path(part.name)
+
+
+def open_text(path):
+    """A dump opened for reading as text, decompressed if its name ends in .gz."""
+    path = Path(path)
+    return gzip.open(path, "rt") if path.suffix == ".gz" else path.open()
 
 
 class TruncatedDump(ValueError):
@@ -60,26 +90,33 @@ class TruncatedDump(ValueError):
 def iter_local(path) -> Iterator[tuple[int, np.ndarray]]:
     """(timestep, rows) of each snapshot of a ``dump local`` file, in file order; a
     snapshot cut off by the end of the file raises ``TruncatedDump``."""
-    with Path(path).open() as f:
+    with open_text(path) as f:
+        try:
+            yield from _snapshots(f, path)
+        except EOFError:          # a compressed stream that a kill left without its end
+            raise TruncatedDump(f"{path}: the compressed dump is cut off") from None
+
+
+def _snapshots(f, path):
+    line = f.readline()
+    while line:
+        if not line.startswith("ITEM: TIMESTEP"):
+            raise ValueError(f"{path}: expected 'ITEM: TIMESTEP', found {line.strip()!r}")
+        try:
+            step = int(f.readline())
+            f.readline()                          # ITEM: NUMBER OF ENTRIES
+            n = int(f.readline())
+        except ValueError:
+            raise TruncatedDump(f"{path}: the last snapshot's header is cut off") from None
         line = f.readline()
-        while line:
-            if not line.startswith("ITEM: TIMESTEP"):
-                raise ValueError(f"{path}: expected 'ITEM: TIMESTEP', found {line.strip()!r}")
-            try:
-                step = int(f.readline())
-                f.readline()                          # ITEM: NUMBER OF ENTRIES
-                n = int(f.readline())
-            except ValueError:
-                raise TruncatedDump(f"{path}: the last snapshot's header is cut off") from None
-            line = f.readline()
-            while line and not line.startswith("ITEM: ENTRIES"):
-                line = f.readline()                  # box bounds
-            columns = len(line.split()) - 2              # after "ITEM: ENTRIES"
-            rows = [f.readline().split() for _ in range(n)]
-            if columns < 1 or any(len(r) != columns for r in rows):
-                raise TruncatedDump(f"{path}: the snapshot of step {step} is cut off")
-            yield step, np.array(rows, dtype=float).reshape(n, columns)
-            line = f.readline()
+        while line and not line.startswith("ITEM: ENTRIES"):
+            line = f.readline()                  # box bounds
+        columns = len(line.split()) - 2              # after "ITEM: ENTRIES"
+        rows = [f.readline().split() for _ in range(n)]
+        if columns < 1 or any(len(r) != columns for r in rows):
+            raise TruncatedDump(f"{path}: the snapshot of step {step} is cut off")
+        yield step, np.array(rows, dtype=float).reshape(n, columns)
+        line = f.readline()
 
 
 def last_local_snapshot(path) -> np.ndarray:
@@ -123,7 +160,7 @@ class Frame:
     pairs: np.ndarray | None  # (n_c, 2) atom IDs of bonded contacts, None without a contact dump
 
 
-def frames(run, atoms="atoms.dump", contacts="contacts.dump") -> Iterator[Frame]:
+def frames(run, atoms=ATOMS, contacts=CONTACTS) -> Iterator[Frame]:
     """The frames of a run directory: positions and radii from ``atoms``, joined by
     timestep to the contact list of ``contacts`` when that file exists. They end at the
     last frame both files hold whole (MDAnalysis drops a cut-off last atoms frame; a

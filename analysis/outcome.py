@@ -41,6 +41,32 @@ class Outcome:
     contacts_per_particle: float      # n_con of the largest fragment
 
 
+def growth_efficiency(n_largest: int, n_target: int, n_projectile: int) -> float:
+    """f_gro = (N_lar - N_tar) / N_pro (3D BPCA paper, sec. 3.1)."""
+    return (n_largest - n_target) / n_projectile
+
+
+def from_checks(rows: list[dict], n_target: int, n_projectile: int) -> list[dict]:
+    """The measures of ``Outcome`` at every check, from the rows of the settle rule's
+    in-run table (``checks.csv``, fix_jkr_dt_settle_table.cpp); a step written twice (a
+    run continued from a restart file) counts once, as written last."""
+    latest = {int(row["step"]): row for row in rows}
+    out = []
+    for step in sorted(latest):
+        row = latest[step]
+        n_lar = int(row["n_largest"])
+        out.append(dict(step=step, n_total=int(row["n_total"]), n_largest=n_lar,
+                        n_second=int(row["n_second"]), n_fragments=int(row["n_fragments"]),
+                        growth_efficiency=growth_efficiency(n_lar, n_target, n_projectile),
+                        gyration_radius_largest=float(row["gyration_radius_largest"]),
+                        contacts_per_particle=int(row["contacts_largest"]) / n_lar,
+                        N_cum_1=int(row["N_cum_1"]), N_cum_4=int(row["N_cum_4"]),
+                        N_cum_16=int(row["N_cum_16"]),
+                        departed_grains=int(row["departed_grains"]),
+                        time=float(row["time"])))
+    return out
+
+
 def measure(x: np.ndarray, labels: np.ndarray, pairs: np.ndarray, n_target: int,
             n_projectile: int, step: int = 0) -> Outcome:
     """Metrics of one frame: positions ``x`` (N, 3), fragment ``labels``, and the bonded
@@ -49,16 +75,18 @@ def measure(x: np.ndarray, labels: np.ndarray, pairs: np.ndarray, n_target: int,
         raise ValueError(f"N_tar + N_pro = {n_target + n_projectile} but the frame has "
                          f"{len(x)} grains: the metadata belong to another run")
     sizes = np.bincount(labels)
-    ranked = np.argsort(sizes)[::-1]
-    largest = labels == ranked[0]
+    # of fragments equally large, the one holding the first grain (labels count up from
+    # the fragment of the first grain) ranks first, as in the settle rule's table
+    first = int(np.argmax(sizes))
+    largest = labels == first
     pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
     inside = largest[pairs[:, 0]] & largest[pairs[:, 1]]
-    n_lar = int(sizes[ranked[0]])
+    n_lar = int(sizes[first])
     return Outcome(
         step=int(step), n_total=len(x), n_largest=n_lar,
-        n_second=int(sizes[ranked[1]]) if len(sizes) > 1 else 0,
+        n_second=int(np.delete(sizes, first).max()) if len(sizes) > 1 else 0,
         n_fragments=len(sizes),
-        growth_efficiency=(n_lar - n_target) / n_projectile,
+        growth_efficiency=growth_efficiency(n_lar, n_target, n_projectile),
         gyration_radius_largest=gyration_radius(x[largest]),
         contacts_per_particle=int(inside.sum()) / n_lar)
 

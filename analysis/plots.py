@@ -44,18 +44,53 @@ BODY_COLOURS = {1: "#4c72b0", 2: "#dd8452"}
 
 #: the smallest drawn grain, as a fraction of the view: fragments spread far apart stay visible
 MIN_DISC = 1.0 / 150
+#: from this many grains a picture is drawn as pixels, not as vector shapes (a PDF of 10^5
+#: outlined discs takes minutes to write and tens of MB), and the grains lose their outlines
+RASTER_FROM = 5000
+#: fragments of at most this many grains are also marked by a ring of fixed size, so that
+#: they stay visible however far the fragments have spread
+MARK_UP_TO = 16
 
 
 def _discs(ax, x, i, j, diameter, colours, alpha=1.0, zorder=1):
-    """Grains as circles of ``diameter`` (micron) in the (i, j) projection, in micron."""
+    """Grains as circles of ``diameter`` (micron) in the (i, j) projection, in micron,
+    the nearest to the viewer (along e_i x e_j) drawn last and brightest, so that a
+    body's depth shows."""
     from matplotlib.collections import EllipseCollection
+    from matplotlib.colors import to_rgba_array
 
+    if len(x) == 0:
+        return
     um = x * 1e6
+    depth = um @ np.cross(np.eye(3)[i], np.eye(3)[j])
+    order = np.argsort(depth, kind="stable")
+    near = (depth - depth.min()) / np.ptp(depth) if np.ptp(depth) > 0 else np.ones(len(x))
+    rgba = to_rgba_array(colours, alpha)
+    if len(rgba) == 1:
+        rgba = np.repeat(rgba, len(x), axis=0)
+    rgba[:, :3] *= (0.6 + 0.4 * near)[:, None]
+    many = len(x) >= RASTER_FROM
     d = np.full(len(x), diameter)
     ax.add_collection(EllipseCollection(d, d, np.zeros(len(x)), units="xy",
-                                        offsets=um[:, [i, j]], offset_transform=ax.transData,
-                                        facecolors=colours, edgecolors="k", linewidths=0.3,
-                                        alpha=alpha, zorder=zorder))
+                                        offsets=um[order][:, [i, j]],
+                                        offset_transform=ax.transData,
+                                        facecolors=rgba[order], edgecolors="k",
+                                        linewidths=0.0 if many else 0.3, zorder=zorder,
+                                        rasterized=many))
+
+
+def _mark_small(ax, x, labels, i, j, zorder=3) -> int:
+    """Rings of fixed size at the centres of the fragments of at most ``MARK_UP_TO``
+    grains; returns how many."""
+    sizes = np.bincount(labels)
+    small = np.flatnonzero((sizes > 0) & (sizes <= MARK_UP_TO))
+    if len(small) == 0:
+        return 0
+    centre = np.stack([np.bincount(labels, x[:, k] * 1e6, minlength=len(sizes))
+                       for k in range(3)], axis=1)[small] / sizes[small, None]
+    ax.scatter(centre[:, i], centre[:, j], s=18, facecolors="none", edgecolors="k",
+               linewidths=0.6, zorder=zorder, rasterized=len(small) >= RASTER_FROM)
+    return len(small)
 
 
 def _frame_axes(ax, x, i, j, radius, names) -> float:
@@ -133,6 +168,7 @@ def outcome(path, start: np.ndarray, end: np.ndarray, body: np.ndarray, labels: 
         d = _frame_axes(e, end, i, j, radius, names)
         _discs(e, end[~big], i, j, d, colours[~big], alpha=0.35)
         _discs(e, end[big], i, j, d, colours[big], zorder=2)
+        marked = _mark_small(e, end, labels, i, j)
     axes[0, 0].set_title("start, " + _when(*when[0], t_c), fontsize=10)
     axes[0, 1].set_title("end, " + _when(*when[1], t_c), fontsize=10)
     axes[0, 0].legend(handles=[Patch(color=BODY_COLOURS[1], label=f"target ({tar.sum()})"),
@@ -151,6 +187,10 @@ def outcome(path, start: np.ndarray, end: np.ndarray, body: np.ndarray, labels: 
     if len(rest):
         handles.append(Patch(color="0.75", label=f"{len(rest)} more, of at most "
                              f"{grains(sizes[rest].max())}"))
+    if marked:
+        handles.append(Line2D([], [], ls="none", marker="o", markerfacecolor="none",
+                              markeredgecolor="k", label=f"{marked} fragment(s) of at most "
+                              f"{MARK_UP_TO} grains, ringed"))
     if departed is not None and departed.any():
         n_gone = len(np.unique(labels[departed]))
         handles.append(Patch(color="none", label=f"{n_gone} fragment(s), {grains(departed.sum())}"

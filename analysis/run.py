@@ -4,8 +4,10 @@
 MDAnalysis AnalysisBase), the energy ledger (analysis.thermo) and the writers
 (analysis.tables, analysis.plots):
 
-    collision.json, log.lammps, atoms.dump, contacts.dump   ->
-    frames.csv     the outcome metrics and the energy partition at every dumped frame
+    collision.json, log.lammps, checks.csv, atoms.dump.gz, contacts.dump.gz   ->
+    frames.csv     the outcome metrics and the energy partition at every settle check
+                   (from the settle rule's table checks.csv), or, for a run without
+                   one, at every dumped frame
     outcome.json   the final outcome, the run's parameters, N_cum, the energy scalings
     outcome.png/pdf, energy.png/pdf   a snapshot of the outcome and the energy partition
 """
@@ -21,10 +23,10 @@ from jkrdt.ledger import CHANNELS, energy_budget, energy_error
 from jkrdt.stopping import ENERGY_WARN, STOP_WORDS
 
 from .dumps import atoms_universe
-from .outcome import CollisionOutcome, energy_scalings
+from .outcome import CollisionOutcome, energy_scalings, from_checks
 from .plots import energy_partition, outcome, timeline
 from .status import run_status
-from .tables import write_csv, write_json
+from .tables import read_csv, write_csv, write_json
 from .thermo import read_thermo
 
 
@@ -70,12 +72,23 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
     if (run / "log.lammps").exists():
         thermo = read_thermo(run / "log.lammps")
         budget = energy_budget(thermo)
-    contacts = run / "contacts.dump"
-    measured = CollisionOutcome(atoms_universe(run / "atoms.dump"), n_tar, n_pro,
+    atoms, contacts, checks = (run / name for name in (scene_module.ATOMS,
+                                                        scene_module.CONTACTS,
+                                                        scene_module.CHECKS))
+    if not atoms.exists():
+        raise FileNotFoundError(f"{atoms} does not exist: run the scene first ('jkrdt run "
+                                f"{run}')" + (f" ({status.problem})" if status.problem else ""))
+    universe = atoms_universe(atoms)
+    table = from_checks(read_csv(checks), n_tar, n_pro) if checks.exists() else []
+    # with the table, the dumps give only the start and the end
+    every = sorted({0, len(universe.trajectory) - 1}) if table else None
+    measured = CollisionOutcome(universe, n_tar, n_pro,
                                 contacts=contacts if contacts.exists() else None,
-                                tolerance=tolerance).run().results
-    rows = [{name: measured[name][k].item() for name in CollisionOutcome.MEASURES}
-            for k in range(len(measured.step))]
+                                tolerance=tolerance).run(frames=every).results
+    dumped = [{name: measured[name][k].item() for name in CollisionOutcome.MEASURES}
+              for k in range(len(measured.step))]
+    last_dumped = dumped[-1]["step"] if dumped else None
+    rows = [r for r in table if last_dumped is None or r["step"] <= last_dumped] or dumped
     for row in rows:
         if budget is not None:
             at = np.flatnonzero(thermo["Step"] == row["step"])
@@ -83,11 +96,11 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
                 row["time"] = float(thermo["Time"][at[0]])
                 row.update({name: float(budget[name][at[0]]) for name in
                             ["kinetic", "potential", "dissipated", *CHANNELS]})
-    if not rows:
-        raise ValueError(f"{run / 'atoms.dump'} has no frames"
+    if not dumped:
+        raise ValueError(f"{atoms} has no frames"
                          + (f" ({status.problem})" if status.problem else ""))
-    last_step = rows[-1]["step"]
-    final = {name: rows[-1][name] for name in CollisionOutcome.MEASURES}
+    last_step = last_dumped
+    final = dumped[-1]
     labels, x_last = measured.labels, measured.positions
     status = run_status(run, last_dump_step=last_step)
     if status.problem and not partial:

@@ -16,6 +16,8 @@ from __future__ import annotations
 import dataclasses
 from pathlib import Path
 
+from jkrdt.scene import LOG
+
 SETTLE_LINE = "jkr/dt/settle: stop_reason"
 
 
@@ -35,7 +37,7 @@ def _settle_fields(line: str) -> dict:
 def run_status(run, last_dump_step: int | None = None) -> RunStatus:
     """The status of run directory ``run`` from its ``log.lammps``; with
     ``last_dump_step``, also whether the dumps reach the end of the run."""
-    log = Path(run) / "log.lammps"
+    log = Path(run) / LOG
     if not log.exists():
         return RunStatus("cut off", None, f"{log} does not exist: no way to tell how the run "
                          "ended")

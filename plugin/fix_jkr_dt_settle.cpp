@@ -28,11 +28,11 @@ using namespace LAMMPS_NS;
 FixJKRDTSettle::FixJKRDTSettle(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), window(5), tolerance(0.01), cap(-1.0), state(RUNNING), last_check(-1),
     now{0, 0, 0, 0.0}, depart(DEPART_NO), departed_bit(0), moving_bits(0), quiet_speed(0.0),
-    break_energy(0.0),
-    departed_grains(0.0), departed_fragments(0.0)
+    break_energy(0.0), departed_grains(0.0), departed_fragments(0.0), table_append(false),
+    table(nullptr)
 {
-  const char *usage =
-      "fix ID all jkr/dt/settle N window K tolerance f [cap T] [depart yes|no|shadow]";
+  const char *usage = "fix ID all jkr/dt/settle N window K tolerance f [cap T] "
+                      "[depart yes|no|shadow] [table FILE] [append yes|no]";
   if (narg < 4) error->all(FLERR, "fix jkr/dt/settle: expected '{}'", usage);
   if (igroup != 0)
     error->all(FLERR, "fix jkr/dt/settle: the fragments are those of all atoms; use group all");
@@ -58,16 +58,26 @@ FixJKRDTSettle::FixJKRDTSettle(LAMMPS *lmp, int narg, char **arg) :
       else if (how == "no") depart = DEPART_NO;
       else if (how == "shadow") depart = DEPART_SHADOW;
       else error->all(FLERR, "fix jkr/dt/settle: depart is yes, no or shadow (got '{}')", how);
+    } else if (key == "table") {
+      table_path = arg[iarg + 1];
+    } else if (key == "append") {
+      table_append = utils::logical(FLERR, arg[iarg + 1], false, lmp) == 1;
     } else {
       error->all(FLERR, "fix jkr/dt/settle: unknown keyword '{}'; expected '{}'", key, usage);
     }
   }
   if (cap > 0.0) cap += simulated_time();    // the cap counts from the fix's definition
+  open_table();
   restart_global = 1;
   vector_flag = 1;
   size_vector = 7;
   global_freq = 1;
   extvector = 0;
+}
+
+FixJKRDTSettle::~FixJKRDTSettle()
+{
+  if (table) fclose(table);
 }
 
 int FixJKRDTSettle::setmask()
@@ -118,6 +128,7 @@ void FixJKRDTSettle::setup(int)
     now = partition(graph);
     last_check = update->ntimestep;
     history.push_back(now);
+    write_check(graph);
   }
 }
 
@@ -148,7 +159,8 @@ FixJKRDTSettle::Partition FixJKRDTSettle::partition(Graph &graph) const
   if (C)
     for (int i = 0; i < atom->nlocal; i++)
       for (int l = 0; l < FixJKRDTContacts::NLEDGER; l++) dissipated += C->ledger[i][l];
-  const std::vector<tagint> edges = FixJKRDTContacts::gather(mine, world);
+  graph.edges = FixJKRDTContacts::gather(mine, world);
+  const std::vector<tagint> &edges = graph.edges;
 
   // union by size over the atoms that have contacts; the others are single grains
   auto &index = graph.index;
@@ -197,6 +209,7 @@ void FixJKRDTSettle::end_of_step()
   history.push_back(now);
   while (static_cast<int>(history.size()) > window + 1) history.pop_front();
 
+  int reason = RUNNING;
   if (static_cast<int>(history.size()) == window + 1) {
     bool same = true;
     bigint lo = now.contacts, hi = now.contacts;
@@ -206,17 +219,15 @@ void FixJKRDTSettle::end_of_step()
       hi = std::max(hi, h.contacts);
     }
     const double dissipating = now.dissipated - history.front().dissipated;
-    if (same && (hi - lo) <= tolerance * hi && dissipating <= tolerance * std::fabs(now.dissipated)) {
-      stop(SETTLED);
-      return;
-    }
+    if (same && (hi - lo) <= tolerance * hi && dissipating <= tolerance * std::fabs(now.dissipated))
+      reason = SETTLED;
   }
   // the cap is met when the next check would lie beyond it
-  if (cap > 0.0 && simulated_time() + 0.5 * nevery * update->dt > cap) {
-    stop(CAP);
-    return;
-  }
-  if (depart != DEPART_NO) find_departures(graph);
+  if (reason == RUNNING && cap > 0.0 && simulated_time() + 0.5 * nevery * update->dt > cap)
+    reason = CAP;
+  if (reason == RUNNING && depart != DEPART_NO) find_departures(graph);
+  write_check(graph);
+  if (reason != RUNNING) stop(reason);
 }
 
 void FixJKRDTSettle::stop(int reason)

@@ -35,14 +35,22 @@
    departure goes there. depart shadow only writes, once per
    fragment, the line "jkr/dt/settle: would depart step S label L size N"
    (L the smallest atom ID) so that the rule can be checked against a run
-   that keeps every fragment.                                                */
+   that keeps every fragment.
+
+   table FILE [append yes|no]: at every check (and at the first set-up) rank 0
+   writes one row of the fragments to FILE, a CSV table
+   (fix_jkr_dt_settle_table.cpp has the columns), so that the timeline of a
+   collision needs no dumps; append yes adds to FILE (a run continued from a
+   restart file), no starts it anew.                                        */
 
 #ifndef JKR_DT_FIX_SETTLE_H
 #define JKR_DT_FIX_SETTLE_H
 
 #include "fix.h"
 
+#include <cstdio>
 #include <deque>
+#include <string>
 #include <unordered_map>
 #include <unordered_set>
 #include <vector>
@@ -62,6 +70,7 @@ class FixJKRDTSettle : public Fix {
   };
 
   FixJKRDTSettle(class LAMMPS *, int, char **);
+  ~FixJKRDTSettle() override;
   int setmask() override;
   void init() override;
   void post_constructor() override;
@@ -86,6 +95,7 @@ class FixJKRDTSettle : public Fix {
   struct Graph {
     std::unordered_map<tagint, int> index;    // atom ID -> node
     std::vector<int> parent, size;
+    std::vector<tagint> edges;                // the bonded contacts, as pairs of atom IDs
     int root(int k);
   };
   Partition partition(Graph &graph) const;
@@ -97,6 +107,11 @@ class FixJKRDTSettle : public Fix {
   std::unordered_set<tagint> shadowed;    // fragments reported by depart shadow
   void find_departures(Graph &graph);
   double simulated_time() const;
+  std::string table_path;        // the in-run table; empty: none
+  bool table_append;
+  FILE *table;
+  void open_table();
+  void write_check(Graph &graph);
   void stop(int reason);
 };
 

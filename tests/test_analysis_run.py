@@ -104,7 +104,7 @@ def test_frames_table_matches_the_session(run):
 
 def test_local_dump_stream(run):
     d, *_ = run
-    steps = [step for step, _ in iter_local(d / "contacts.dump")]
+    steps = [step for step, _ in iter_local(d / scene_module.CONTACTS)]
     assert steps == list(range(0, 12001, 1000))
 
 
@@ -126,16 +126,16 @@ def test_collision_outcome_is_an_mdanalysis_analysis(run):
     from jkrdt.analysis.outcome import CollisionOutcome
     d, *_ = run
     rows = read_csv(d / "frames.csv")
-    u = atoms_universe(d / "atoms.dump")
-    full = CollisionOutcome(u, N, N, contacts=d / "contacts.dump").run()
+    u = atoms_universe(d / scene_module.ATOMS)
+    full = CollisionOutcome(u, N, N, contacts=d / scene_module.CONTACTS).run()
     assert list(full.results.step) == list(range(0, 12001, 1000))
     for name in ("n_largest", "n_fragments", "contacts_per_particle", "growth_efficiency"):
         assert np.allclose(full.results[name], [float(r[name]) for r in rows]), name
-    sliced = CollisionOutcome(u, N, N, contacts=d / "contacts.dump").run(start=2, stop=11,
+    sliced = CollisionOutcome(u, N, N, contacts=d / scene_module.CONTACTS).run(start=2, stop=11,
                                                                          step=3)
     assert list(sliced.results.step) == [2000, 5000, 8000]
     assert np.array_equal(sliced.results.n_largest, full.results.n_largest[2:11:3])
-    backwards_again = CollisionOutcome(u, N, N, contacts=d / "contacts.dump").run(stop=3)
+    backwards_again = CollisionOutcome(u, N, N, contacts=d / scene_module.CONTACTS).run(stop=3)
     assert list(backwards_again.results.step) == [0, 1000, 2000]
     # without the contact dump: fragments from positions within delta_c, the same at the end
     by_positions = CollisionOutcome(u, N, N, tolerance=S.delta_c).run(start=12)

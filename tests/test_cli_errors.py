@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from jkrdt import scene as scene_module
 from jkrdt.analysis.dumps import iter_local
 
 JKRDT = str(Path(sys.executable).parent / "jkrdt")
@@ -47,12 +48,12 @@ def test_analyse_of_a_directory_that_is_no_scene(tmp_path):
 def test_setup_refuses_a_used_directory_unless_forced(tmp_path):
     setup = ["setup", "--kind", "bcca", "--dim", "2", "--n-tar", "8", "--n-pro", "8",
              "--out", tmp_path]
-    (tmp_path / "atoms.dump").write_text("an earlier run's dump")
+    (tmp_path / scene_module.ATOMS).write_text("an earlier run's dump")
     (tmp_path / "notes.txt").write_text("the user's own file")
     one_line_error(setup, "is not empty; choose another --out, or give --force")
     code, err = jkrdt(*setup, "--force")
     assert code == 0, err
-    assert not (tmp_path / "atoms.dump").exists()                 # what it owns is cleared
+    assert not (tmp_path / scene_module.ATOMS).exists()                 # what it owns is cleared
     assert (tmp_path / "notes.txt").read_text() == "the user's own file"
     assert (tmp_path / "collision.json").exists()
 

@@ -60,8 +60,8 @@ def run_deck(workdir, data, model, nproc=1, steps=STEPS, restart=None, extra=(),
 
 
 def last_local_dump(workdir):
-    """Rows of the last snapshot of the deck's contacts.dump (dump local)."""
-    return last_local_snapshot(workdir / "contacts.dump")
+    """Rows of the last snapshot of the deck's contact dump (dump local)."""
+    return last_local_snapshot(workdir / scene_module.CONTACTS)
 
 
 def scale_error(a, b):
@@ -73,7 +73,7 @@ def scale_error(a, b):
 @pytest.fixture(scope="module")
 def serial_dir(scene, model, tmp_path_factory):
     d = tmp_path_factory.mktemp("serial")
-    run_deck(d, scene, model)
+    run_deck(d, scene, model, extra=("-var", "keep_restarts", "yes"))   # for the mid-run restart
     return d
 
 

@@ -10,6 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from jkrdt import scene as scene_module
+from jkrdt.analysis.dumps import open_text
 from jkrdt.session import Session
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -40,16 +42,19 @@ def test_chunks_sample_the_energy_budget(serial):
 
 def test_dumps_and_restarts_on_request(serial):
     out, _, _ = serial
-    steps = [int(block.split()[0]) for block in
-             (out / "atoms.dump").read_text().split("ITEM: TIMESTEP\n")[1:]]
+    with open_text(out / scene_module.ATOMS) as f:
+        steps = [int(block.split()[0]) for block in f.read().split("ITEM: TIMESTEP\n")[1:]]
     assert steps == [0, 500, 1000, 1500, 2000]
-    assert (out / "restart.a").exists() and (out / "contacts.dump").exists()
+    # a session that closes after no error ends its record as the deck does: final.restart
+    # replaces the rolling restart files
+    assert (out / "final.restart").exists() and not (out / "restart.a").exists()
+    assert (out / scene_module.CONTACTS).exists()
 
 
 def test_no_outputs_unless_asked(tmp_path):
     with Session(SCENE, tmp_path) as session:
         session.run(10, progress=False)
-    assert not (tmp_path / "atoms.dump").exists() and not (tmp_path / "restart.a").exists()
+    assert not (tmp_path / scene_module.ATOMS).exists() and not (tmp_path / "restart.a").exists()
 
 
 def test_continuing_from_a_restart_repeats_the_run(serial, tmp_path):

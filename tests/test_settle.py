@@ -43,7 +43,7 @@ def settle_line(log):
 @pytest.fixture(scope="module")
 def settled(tmp_path_factory):
     d = write_scene(tmp_path_factory.mktemp("settled"))
-    with Session(d, d, every=1, settle=RULE) as s:
+    with Session(d, d, every=1, settle=RULE, variables=dict(frames=1)) as s:
         s.run_until_settled(progress=False)
         reason, energy_error = s.stop_reason, s.energy_error()
     return d, reason, energy_error
@@ -115,8 +115,8 @@ def test_cut_off_run_is_refused_unless_partial(settled, tmp_path):
     d, *_ = settled
     cut = tmp_path / "cut"
     cut.mkdir()
-    for name in ("collision.json", "atoms.dump", "contacts.dump"):
-        (cut / name).write_text((d / name).read_text())
+    for name in ("collision.json", scene_module.ATOMS, scene_module.CONTACTS):
+        (cut / name).write_bytes((d / name).read_bytes())
     # the log of a process killed in mid-run: it ends inside a thermo block
     log = (d / "log.lammps").read_text().splitlines()
     last_loop = max(k for k, line in enumerate(log) if line.startswith("Loop time of"))
@@ -149,12 +149,12 @@ def test_two_ranks_find_the_fragments_the_analysis_finds(tmp_path):
     assert sizes.max() == int(fields["N_lar"]) and len(sizes) == int(fields["fragments"])
 
 
-@pytest.mark.parametrize("cut", ["atoms.dump", "contacts.dump"])
+@pytest.mark.parametrize("cut", [scene_module.ATOMS, scene_module.CONTACTS])
 def test_truncated_dump_is_refused_unless_partial(settled, tmp_path, cut):
     d, *_ = settled
     run = tmp_path / "run"
     run.mkdir()
-    for name in ("collision.json", "log.lammps", "atoms.dump", "contacts.dump"):
+    for name in ("collision.json", "log.lammps", scene_module.ATOMS, scene_module.CONTACTS):
         (run / name).write_bytes((d / name).read_bytes())
     data = (run / cut).read_bytes()
     (run / cut).write_bytes(data[: int(0.97 * len(data))])   # killed while writing

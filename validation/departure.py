@@ -32,6 +32,7 @@ import numpy as np
 from common import campaign_paths, run_campaigns
 from jkrdt.analysis import dumps, fragments
 from jkrdt.analysis.tables import write_csv
+from jkrdt.scene import CONTACTS
 
 HERE = Path(__file__).resolve().parent
 FULL = dict(n=1000, seeds=list(range(1, 9)), v_col=[20.0, 39.8, 100.0],
@@ -53,7 +54,7 @@ def wrong_departures(run: Path) -> tuple[int, int]:
     would = [tuple(map(int, m.groups())) for m in WOULD.finditer((run / "log.lammps").read_text())]
     meta = json.loads((run / "collision.json").read_text())
     ids = np.arange(1, meta["N_tar"] + meta["N_pro"] + 1)
-    pairs = dumps.last_local_snapshot(run / "contacts.dump")[:, :2].astype(np.int64)
+    pairs = dumps.last_local_snapshot(run / CONTACTS)[:, :2].astype(np.int64)
     labels = fragments.from_contacts(ids, pairs)
     sizes = np.bincount(labels)
     smallest = np.full(labels.max() + 1, ids.max() + 1)

@@ -38,6 +38,7 @@ file, so the run ends as the uninterrupted one would have.
 from __future__ import annotations
 
 import fcntl
+import gzip
 import json
 import os
 import socket
@@ -215,22 +216,35 @@ def resume_point(directory: Path):
 
 
 def cut_dump(path: Path, step: int) -> None:
-    """Keep the snapshots of a dump before ``step`` (the resumed run writes ``step`` again)."""
+    """Keep the snapshots of a dump (plain or compressed) before ``step`` (the resumed run
+    writes ``step`` again); a compressed stream cut off by a kill ends where it was cut."""
     if not path.exists():
         return
-    offset, end = 0, None
-    with path.open("rb") as f:
-        for line in f:
-            if line.startswith(b"ITEM: TIMESTEP"):
-                at = f.readline()
-                if int(at) >= step:
-                    end = offset
-                    break
-                offset += len(at)
-            offset += len(line)
-    if end is not None:
-        with path.open("r+b") as f:
-            f.truncate(end)
+    opener = gzip.open if path.suffix == ".gz" else open
+    kept = path.with_name(path.name + ".cut")
+    with opener(path, "rb") as src, opener(kept, "wb") as dst:
+        try:
+            for line in src:
+                if line.startswith(b"ITEM: TIMESTEP"):
+                    at = src.readline()
+                    if int(at) >= step:
+                        break
+                    line += at
+                dst.write(line)
+        except EOFError:
+            pass
+    kept.replace(path)
+
+
+def cut_table(path: Path, step: int) -> None:
+    """Keep the rows of the settle rule's table up to ``step`` (its check at ``step`` came
+    before the restart file; the resumed run writes the checks after it)."""
+    if not path.exists():
+        return
+    lines = path.read_text(errors="replace").splitlines(keepends=True)
+    keep = [line for line in lines[1:] if line.split(",")[0].isdigit()
+            and int(line.split(",")[0]) <= step and line.endswith("\n")]
+    path.write_text("".join(lines[:1] + keep))
 
 
 def cut_log(path: Path, step: int) -> None:
@@ -258,9 +272,10 @@ def prepare(directory: Path, scene: Scene, aggregates: dict):
             return "ended"
     point = resume_point(directory)
     if point is not None:
-        for name in ("atoms.dump", "contacts.dump"):
+        for name in (scene_module.ATOMS, scene_module.CONTACTS):
             cut_dump(directory / name, point[1])
-        cut_log(directory / "log.lammps", point[1])
+        cut_table(directory / scene_module.CHECKS, point[1])
+        cut_log(directory / scene_module.LOG, point[1])
         return point
     for name in scene_module.SCENE_FILES:
         (directory / name).unlink(missing_ok=True)
@@ -288,7 +303,7 @@ def run_one(spec: dict, directory: Path, resume, comm) -> str | None:
                 run.run(spec["steps"] - start, chunk=spec["every"], progress=False)
             else:
                 run.run_until_settled(progress=False)
-            run.write_restart()
+            run.finish()
     except Exception as err:            # a LAMMPS error: recorded, the campaign goes on
         return str(err).strip().splitlines()[0]
     return None

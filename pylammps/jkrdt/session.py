@@ -14,6 +14,7 @@ same arrays; the progress bar shows on rank 0.
 
 from __future__ import annotations
 
+import re
 import warnings
 from pathlib import Path
 
@@ -107,6 +108,7 @@ class Session:
         self.meta = scene_module.read_metadata(scene)
         self.scene = scene_module.from_metadata(self.meta)
         deck = scene_module.deck(scene)
+        self.deck = deck
         self.settle = settle
         self.stop_reason: str | None = None
         chosen = dict(file=scene / scene_module.DATA, out=self.out, every=every or 1000,
@@ -122,10 +124,12 @@ class Session:
         if append:
             chosen.update(append="yes")
         chosen.update(variables or {})
-        self.lmp = start_lammps(self.comm, log=None if append else self.out / "log.lammps",
+        self.outputs = chosen["outputs"] == "yes"
+        self._finished = False
+        self.lmp = start_lammps(self.comm, log=None if append else self.out / scene_module.LOG,
                                 screen=screen)
         if append:
-            self.lmp.command(f"log {self.out / 'log.lammps'} append")
+            self.lmp.command(f"log {self.out / scene_module.LOG} append")
         read_deck(self.lmp, chosen, deck)
         # the cap as a step: the deck's steps counted from where the run starts
         start = int(self.lmp.extract_global("ntimestep"))
@@ -209,6 +213,22 @@ class Session:
         """Kinetic, potential, dissipated (in all and by channel) and total energy."""
         return ledger.energy_budget(self.thermo())
 
+    def finish(self) -> None:
+        """End the run as the scene's deck does after its ``run`` (the part from its
+        ``label finish``): the last frames, final.restart and final.dump, and the rolling
+        restart files removed. A session with outputs does this when it closes after no
+        error; the dumps end here."""
+        if self._finished:
+            return
+        self._finished = True
+        text = self.deck.read_text()
+        start = re.search(r"^label\s+finish\s*$", text, re.M)
+        end = re.search(r"^label\s+end\s*$", text, re.M)
+        if start is None or end is None:
+            raise ValueError(f"{self.deck} has no 'label finish' ... 'label end' part: "
+                             "write it anew with jkrdt.scene.write_deck")
+        self.lmp.commands_string(text[start.end():end.start()])
+
     def write_restart(self, path=None) -> Path:
         path = Path(path) if path is not None else self.out / "final.restart"
         self.lmp.command(f"write_restart {path}")
@@ -229,5 +249,9 @@ class Session:
     def __enter__(self):
         return self
 
-    def __exit__(self, *exc):
-        self.close()
+    def __exit__(self, exc_type, *exc):
+        try:
+            if exc_type is None and self.outputs and self.lmp is not None:
+                self.finish()
+        finally:
+            self.close()

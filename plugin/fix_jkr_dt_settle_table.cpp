@@ -1,0 +1,112 @@
+/* jkr/dt: the in-run table of fix jkr/dt/settle (table FILE).
+
+   One row per check, from the fragments the check has just found, in the
+   papers' measures (3D BPCA paper sec. 3; Wada et al. 2007 eqs. 50, 56-57):
+
+     step, time                 the check
+     n_total                    grains
+     n_largest, n_second        the largest and second-largest fragment; of
+                                fragments equally large, the one holding the
+                                smallest atom ID ranks first
+     n_fragments                fragments, single grains included
+     contacts                   bonded contacts of all grains
+     contacts_largest           bonded contacts inside the largest fragment
+                                (n_con = contacts_largest / n_largest)
+     gyration_radius_largest    r_g of the largest fragment (equal grains), m
+     N_cum_1, N_cum_4, N_cum_16 grains in fragments of at most 1, 4, 16 grains
+     departed_grains, departed_fragments   what has departed so far
+
+   Every rank holds the whole contact graph, so only r_g needs a reduction.
+   Rows are flushed as they are written: a run that is killed leaves whole
+   rows, and one continued from a restart file appends rows for steps that
+   may already be there (the later row is the one that counts).             */
+
+#include "fix_jkr_dt_settle.h"
+
+#include "atom.h"
+#include "comm.h"
+#include "domain.h"
+#include "error.h"
+#include "update.h"
+#include "utils.h"
+
+#include <algorithm>
+#include <vector>
+
+using namespace LAMMPS_NS;
+
+void FixJKRDTSettle::open_table()
+{
+  if (table_path.empty() || comm->me != 0) return;
+  table = fopen(table_path.c_str(), table_append ? "a" : "w");
+  if (!table)
+    error->one(FLERR, "fix jkr/dt/settle: cannot write the table {}: {}; check that its "
+               "directory exists and is writable", table_path, utils::getsyserror());
+  if (ftell(table) == 0)
+    fputs("step,time,n_total,n_largest,n_second,n_fragments,contacts,contacts_largest,"
+          "gyration_radius_largest,N_cum_1,N_cum_4,N_cum_16,departed_grains,"
+          "departed_fragments\n", table);
+}
+
+void FixJKRDTSettle::write_check(Graph &graph)
+{
+  if (table_path.empty()) return;
+  // the fragments of more than one grain: their sizes and smallest atom IDs, by root
+  const int nodes = static_cast<int>(graph.parent.size());
+  std::vector<tagint> smallest(nodes, -1);
+  for (const auto &entry : graph.index) {
+    const int r = graph.root(entry.second);
+    if (smallest[r] < 0 || entry.first < smallest[r]) smallest[r] = entry.first;
+  }
+  const bigint singles = atom->natoms - static_cast<bigint>(nodes);
+  bigint cum4 = singles, cum16 = singles, first = 0, second = singles > 0 ? 1 : 0;
+  int largest = -1;
+  for (int k = 0; k < nodes; k++) {
+    if (graph.parent[k] != k) continue;
+    const bigint n = graph.size[k];
+    if (n <= 4) cum4 += n;
+    if (n <= 16) cum16 += n;
+    const bool ahead = largest < 0 || n > first || (n == first && smallest[k] < smallest[largest]);
+    if (ahead) {
+      second = std::max(second, first);
+      first = n;
+      largest = k;
+    } else {
+      second = std::max(second, n);
+    }
+  }
+  if (largest < 0) {    // no contact at all: every fragment is one grain
+    first = atom->natoms > 0 ? 1 : 0;
+    second = atom->natoms > 1 ? 1 : 0;
+  }
+  bigint inside = 0;
+  for (size_t e = 0; largest >= 0 && e < graph.edges.size(); e += 2)
+    if (graph.root(graph.index.at(graph.edges[e])) == largest) inside++;
+
+  // r_g of the largest fragment, eq. (50): about the box centre, then shifted
+  double centre[3], local[5] = {0, 0, 0, 0, 0}, total[5];
+  for (int d = 0; d < 3; d++) centre[d] = 0.5 * (domain->boxlo[d] + domain->boxhi[d]);
+  double **x = atom->x;
+  for (int i = 0; largest >= 0 && i < atom->nlocal; i++) {
+    auto it = graph.index.find(atom->tag[i]);
+    if (it == graph.index.end() || graph.root(it->second) != largest) continue;
+    local[0] += 1.0;
+    for (int d = 0; d < 3; d++) {
+      const double dx = x[i][d] - centre[d];
+      local[1 + d] += dx;
+      local[4] += dx * dx;
+    }
+  }
+  MPI_Allreduce(local, total, 5, MPI_DOUBLE, MPI_SUM, world);
+  double rg = 0.0;
+  if (total[0] > 0.0) {
+    double mean2 = 0.0;
+    for (int d = 0; d < 3; d++) mean2 += (total[1 + d] / total[0]) * (total[1 + d] / total[0]);
+    rg = std::sqrt(std::max(0.0, total[4] / total[0] - mean2));
+  }
+  if (comm->me != 0 || !table) return;
+  fmt::print(table, "{},{:.17g},{},{},{},{},{},{},{:.17g},{},{},{},{:.17g},{:.17g}\n",
+             update->ntimestep, simulated_time(), atom->natoms, first, second, now.n_fragments,
+             now.contacts, inside, rg, singles, cum4, cum16, departed_grains, departed_fragments);
+  fflush(table);
+}
