@@ -63,7 +63,8 @@ def from_checks(rows: list[dict], n_target: int, n_projectile: int) -> list[dict
                         N_cum_1=int(row["N_cum_1"]), N_cum_4=int(row["N_cum_4"]),
                         N_cum_16=int(row["N_cum_16"]),
                         departed_grains=int(row["departed_grains"]),
-                        time=float(row["time"])))
+                        time=float(row["time"]),
+                        **{k: float(row[k]) for k in ("wall", "memory_mb") if k in row}))
     return out
 
 

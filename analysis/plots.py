@@ -47,9 +47,11 @@ MIN_DISC = 1.0 / 150
 #: from this many grains a picture is drawn as pixels, not as vector shapes (a PDF of 10^5
 #: outlined discs takes minutes to write and tens of MB), and the grains lose their outlines
 RASTER_FROM = 5000
-#: fragments of at most this many grains are also marked by a ring of fixed size, so that
-#: they stay visible however far the fragments have spread
+#: fragments of at most this many grains are also marked at their centre, by a ring of
+#: fixed size (by a dot where there are more than RINGS_UP_TO of them), so that they stay
+#: visible however far the fragments have spread
 MARK_UP_TO = 16
+RINGS_UP_TO = 200
 
 
 def _discs(ax, x, i, j, diameter, colours, alpha=1.0, zorder=1):
@@ -79,17 +81,21 @@ def _discs(ax, x, i, j, diameter, colours, alpha=1.0, zorder=1):
                                         rasterized=many))
 
 
-def _mark_small(ax, x, labels, i, j, zorder=3) -> int:
-    """Rings of fixed size at the centres of the fragments of at most ``MARK_UP_TO``
-    grains; returns how many."""
+def _mark_small(ax, x, labels, i, j, zorder=1.5) -> int:
+    """Rings (dots, when many) of fixed size at the centres of the fragments of at most
+    ``MARK_UP_TO`` grains, under the largest fragments; returns how many."""
     sizes = np.bincount(labels)
     small = np.flatnonzero((sizes > 0) & (sizes <= MARK_UP_TO))
     if len(small) == 0:
         return 0
     centre = np.stack([np.bincount(labels, x[:, k] * 1e6, minlength=len(sizes))
                        for k in range(3)], axis=1)[small] / sizes[small, None]
-    ax.scatter(centre[:, i], centre[:, j], s=18, facecolors="none", edgecolors="k",
-               linewidths=0.6, zorder=zorder, rasterized=len(small) >= RASTER_FROM)
+    if len(small) <= RINGS_UP_TO:
+        ax.scatter(centre[:, i], centre[:, j], s=18, facecolors="none", edgecolors="k",
+                   linewidths=0.6, zorder=zorder)
+    else:
+        ax.scatter(centre[:, i], centre[:, j], s=2, c="0.2", linewidths=0, zorder=zorder,
+                   rasterized=True)
     return len(small)
 
 
@@ -188,9 +194,12 @@ def outcome(path, start: np.ndarray, end: np.ndarray, body: np.ndarray, labels: 
         handles.append(Patch(color="0.75", label=f"{len(rest)} more, of at most "
                              f"{grains(sizes[rest].max())}"))
     if marked:
-        handles.append(Line2D([], [], ls="none", marker="o", markerfacecolor="none",
-                              markeredgecolor="k", label=f"{marked} fragment(s) of at most "
-                              f"{MARK_UP_TO} grains, ringed"))
+        ringed = marked <= RINGS_UP_TO
+        handles.append(Line2D([], [], ls="none", marker="o", markersize=5 if ringed else 2,
+                              markerfacecolor="none" if ringed else "0.2",
+                              markeredgecolor="k" if ringed else "0.2",
+                              label=f"{marked} fragment(s) of at most {MARK_UP_TO} grains, "
+                              + ("ringed" if ringed else "a dot at each centre")))
     if departed is not None and departed.any():
         n_gone = len(np.unique(labels[departed]))
         handles.append(Patch(color="none", label=f"{n_gone} fragment(s), {grains(departed.sum())}"

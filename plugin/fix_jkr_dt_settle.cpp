@@ -29,7 +29,7 @@ FixJKRDTSettle::FixJKRDTSettle(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), window(5), tolerance(0.01), cap(-1.0), state(RUNNING), last_check(-1),
     now{0, 0, 0, 0.0}, depart(DEPART_NO), departed_bit(0), moving_bits(0), quiet_speed(0.0),
     break_energy(0.0), departed_grains(0.0), departed_fragments(0.0), table_append(false),
-    table(nullptr)
+    table(nullptr), table_start(0.0)
 {
   const char *usage = "fix ID all jkr/dt/settle N window K tolerance f [cap T] "
                       "[depart yes|no|shadow] [table FILE] [append yes|no]";

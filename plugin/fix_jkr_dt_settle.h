@@ -110,6 +110,7 @@ class FixJKRDTSettle : public Fix {
   std::string table_path;        // the in-run table; empty: none
   bool table_append;
   FILE *table;
+  double table_start;            // wall-clock time the fix was defined
   void open_table();
   void write_check(Graph &graph);
   void stop(int reason);

@@ -15,6 +15,12 @@
      gyration_radius_largest    r_g of the largest fragment (equal grains), m
      N_cum_1, N_cum_4, N_cum_16 grains in fragments of at most 1, 4, 16 grains
      departed_grains, departed_fragments   what has departed so far
+     wall                       wall-clock seconds since the fix was defined
+     memory_mb, peak_rss_mb     the largest over the ranks of LAMMPS's own count
+                                of its memory and of the peak resident size, MB
+
+   so that the cost of a run against simulated time, and its memory, come
+   with every run.
 
    Every rank holds the whole contact graph, so only r_g needs a reduction.
    Rows are flushed as they are written: a run that is killed leaves whole
@@ -27,6 +33,8 @@
 #include "comm.h"
 #include "domain.h"
 #include "error.h"
+#include "info.h"
+#include "platform.h"
 #include "update.h"
 #include "utils.h"
 
@@ -37,6 +45,7 @@ using namespace LAMMPS_NS;
 
 void FixJKRDTSettle::open_table()
 {
+  table_start = platform::walltime();
   if (table_path.empty() || comm->me != 0) return;
   table = fopen(table_path.c_str(), table_append ? "a" : "w");
   if (!table)
@@ -45,7 +54,7 @@ void FixJKRDTSettle::open_table()
   if (ftell(table) == 0)
     fputs("step,time,n_total,n_largest,n_second,n_fragments,contacts,contacts_largest,"
           "gyration_radius_largest,N_cum_1,N_cum_4,N_cum_16,departed_grains,"
-          "departed_fragments\n", table);
+          "departed_fragments,wall,memory_mb,peak_rss_mb\n", table);
 }
 
 void FixJKRDTSettle::write_check(Graph &graph)
@@ -104,9 +113,15 @@ void FixJKRDTSettle::write_check(Graph &graph)
     for (int d = 0; d < 3; d++) mean2 += (total[1 + d] / total[0]) * (total[1 + d] / total[0]);
     rg = std::sqrt(std::max(0.0, total[4] / total[0] - mean2));
   }
+  double memory[3], largest_memory[2];
+  Info(lmp).get_memory_info(memory);    // MB: LAMMPS's count, the heap, the peak resident size
+  memory[1] = memory[2];
+  MPI_Allreduce(memory, largest_memory, 2, MPI_DOUBLE, MPI_MAX, world);
   if (comm->me != 0 || !table) return;
-  fmt::print(table, "{},{:.17g},{},{},{},{},{},{},{:.17g},{},{},{},{:.17g},{:.17g}\n",
+  fmt::print(table,
+             "{},{:.17g},{},{},{},{},{},{},{:.17g},{},{},{},{:.17g},{:.17g},{:.6g},{:.6g},{:.6g}\n",
              update->ntimestep, simulated_time(), atom->natoms, first, second, now.n_fragments,
-             now.contacts, inside, rg, singles, cum4, cum16, departed_grains, departed_fragments);
+             now.contacts, inside, rg, singles, cum4, cum16, departed_grains, departed_fragments,
+             platform::walltime() - table_start, largest_memory[0], largest_memory[1]);
   fflush(table);
 }

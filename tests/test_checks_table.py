@@ -68,6 +68,12 @@ def test_the_table_equals_the_analysis_of_every_frame(runs):
             assert row[f"N_cum_{k}"] == sizes[sizes <= k].sum(), (frame.step, k)
         seen += 1
     assert seen == len(table) > 10
+    # the cost and memory come with the run: wall-clock seconds that only grow, and the
+    # memory per rank as LAMMPS counts it
+    steps = sorted(table)
+    wall = np.array([table[k]["wall"] for k in steps])
+    assert np.all(np.diff(wall) >= 0) and wall[-1] > 0
+    assert all(table[k]["memory_mb"] > 0 for k in steps)
     last = table[max(table)]
     assert last["n_fragments"] > 20 and last["N_cum_1"] > 0     # it shattered
     # what left plus what stayed is every grain: the table's departed grains are those the

@@ -45,7 +45,7 @@ KEPT = ("outcome.json", "frames.csv", scene_module.CHECKS, "outcome.png", "timel
 def timed(cmd: list[str], log: Path) -> dict:
     """Run ``cmd`` under GNU time: wall seconds and the largest resident set of any of its
     processes (for mpirun: of the busiest rank), MB."""
-    stats = log.with_suffix(".time")
+    stats = log.with_name(log.name + ".time")
     with log.open("w") as out:
         subprocess.run(["/usr/bin/time", "-f", "%e %M", "-o", str(stats), *map(str, cmd)],
                        stdout=out, stderr=subprocess.STDOUT, check=True)
