@@ -69,8 +69,8 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
     tolerance = s.delta_c if tolerance is None else tolerance
     n_tar, n_pro = scene.n_tar, scene.n_pro
     budget, thermo = None, None
-    if (run / "log.lammps").exists():
-        thermo = read_thermo(run / "log.lammps")
+    if (run / scene_module.LOG).exists():
+        thermo = read_thermo(run / scene_module.LOG)
         budget = energy_budget(thermo)
     atoms, contacts, checks = (run / name for name in (scene_module.ATOMS,
                                                         scene_module.CONTACTS,

@@ -9,7 +9,8 @@ Each goes through the user's three commands, each timed with its peak memory:
     jkrdt run DIR --np 2             (to the settle rule, departures on: the defaults)
     jkrdt analyse DIR
 
-and the run's record is measured file by file. Writes RESULTS/<name>/ (stages.json with
+and the run's record is measured file by file. A run still going after ``--limit-minutes``
+(default 60) is stopped there and analysed with --partial. Writes RESULTS/<name>/ (stages.json with
 each stage's wall time and memory, the output sizes, the outcome; and the run's
 outcome.json, frames.csv, checks.csv and pictures). Runs go to ``--runs`` (default
 validation/runs/paper_size, not committed). A second call skips the stages already done.
@@ -22,14 +23,19 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import time
 from pathlib import Path
 
+import numpy as np
+
 from jkrdt import scene as scene_module
+from jkrdt.analysis.tables import read_csv
 
 HERE = Path(__file__).resolve().parent
 BIN = Path(sys.executable).parent
@@ -42,13 +48,24 @@ KEPT = ("outcome.json", "frames.csv", scene_module.CHECKS, "outcome.png", "timel
         "energy.png")
 
 
-def timed(cmd: list[str], log: Path) -> dict:
+def timed(cmd: list[str], log: Path, limit: float | None = None) -> dict:
     """Run ``cmd`` under GNU time: wall seconds and the largest resident set of any of its
-    processes (for mpirun: of the busiest rank), MB."""
+    processes (for mpirun: of the busiest rank), MB. Past ``limit`` seconds the command and
+    all its processes are stopped, and the result says so (``cut_at_limit``)."""
     stats = log.with_name(log.name + ".time")
+    t0 = time.time()
     with log.open("w") as out:
-        subprocess.run(["/usr/bin/time", "-f", "%e %M", "-o", str(stats), *map(str, cmd)],
-                       stdout=out, stderr=subprocess.STDOUT, check=True)
+        child = subprocess.Popen(["/usr/bin/time", "-f", "%e %M", "-o", str(stats),
+                                  *map(str, cmd)], stdout=out, stderr=subprocess.STDOUT,
+                                 start_new_session=True)
+        try:
+            code = child.wait(timeout=limit)
+        except subprocess.TimeoutExpired:
+            os.killpg(child.pid, signal.SIGTERM)
+            child.wait()
+            return dict(seconds=round(time.time() - t0, 1), cut_at_limit=True)
+    if code != 0:
+        raise subprocess.CalledProcessError(code, cmd)
     wall, rss = stats.read_text().split()[-2:]
     return dict(seconds=float(wall), peak_rss_mb=int(rss) / 1024)
 
@@ -69,7 +86,19 @@ def output_sizes(run: Path) -> dict:
                                         if k not in (scene_module.DATA,)) / 2 ** 20, 1))
 
 
-def study(name: str, n: int, ranks: int, runs: Path, results: Path) -> dict:
+def per_check(table: Path) -> dict:
+    """Wall seconds per check at the start and the end of a run, and the memory per rank,
+    from the settle rule's table."""
+    rows = read_csv(table)
+    wall = np.diff([r["wall"] for r in rows])
+    return dict(checks=len(rows) - 1,
+                seconds_first_3=float(np.mean(wall[:3])), seconds_last_3=float(np.mean(wall[-3:])),
+                memory_mb_first=rows[0]["memory_mb"], memory_mb_last=rows[-1]["memory_mb"],
+                peak_rss_mb=max(r["peak_rss_mb"] for r in rows))
+
+
+def study(name: str, n: int, ranks: int, runs: Path, results: Path,
+          limit: float | None) -> dict:
     run = runs / name
     run.mkdir(parents=True, exist_ok=True)
     state_path = run / "stage.json"
@@ -82,12 +111,15 @@ def study(name: str, n: int, ranks: int, runs: Path, results: Path) -> dict:
                                 "--out", run, "--force"], run / "stage.setup")
         state_path.write_text(json.dumps(state, indent=2))
     if "run" not in state:
-        state["run"] = timed([BIN / "jkrdt", "run", run, "--np", ranks], run / "stage.run")
+        state["run"] = timed([BIN / "jkrdt", "run", run, "--np", ranks], run / "stage.run",
+                             limit=limit)
         state["run"]["lammps_memory_per_rank_mb"] = lammps_memory(run / scene_module.LOG)
         state["run"]["ranks"] = ranks
         state_path.write_text(json.dumps(state, indent=2))
     if "analyse" not in state:
-        state["analyse"] = timed([BIN / "jkrdt", "analyse", run], run / "stage.analyse")
+        partial = ["--partial"] if state["run"].get("cut_at_limit") else []
+        state["analyse"] = timed([BIN / "jkrdt", "analyse", run, *partial],
+                                 run / "stage.analyse")
         state_path.write_text(json.dumps(state, indent=2))
     out = json.loads((run / "outcome.json").read_text())
     state["outputs"] = output_sizes(run)
@@ -102,6 +134,7 @@ def study(name: str, n: int, ranks: int, runs: Path, results: Path) -> dict:
     log = (run / scene_module.LOG).read_text()
     loops = [float(m) for m in re.findall(r"Loop time of ([0-9.eE+-]+)", log)]
     state["run"]["loop_seconds"] = sum(loops)
+    state["run"]["per_check"] = per_check(run / scene_module.CHECKS)
     state_path.write_text(json.dumps(state, indent=2))
     target = results / name
     target.mkdir(parents=True, exist_ok=True)
@@ -116,13 +149,17 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, default=50000, help="grains per aggregate")
     parser.add_argument("--ranks", type=int, default=2)
+    parser.add_argument("--limit-minutes", type=float, default=60.0,
+                        help="wall time after which a run is stopped and analysed as it is "
+                             "(the issue's bound: one hour)")
     parser.add_argument("--only", choices=list(SCENES), action="append")
     parser.add_argument("--runs", type=Path, default=HERE / "runs" / "paper_size")
     parser.add_argument("--results", type=Path, default=HERE / "paper_size")
     args = parser.parse_args(argv)
     for name in args.only or list(SCENES):
         t0 = time.time()
-        state = study(name, args.n, args.ranks, args.runs, args.results)
+        state = study(name, args.n, args.ranks, args.runs, args.results,
+                      60.0 * args.limit_minutes)
         print(f"{name}: " + ", ".join(f"{k} {state[k]['seconds']:.0f} s"
                                        for k in ("setup", "run", "analyse"))
               + f"; record {state['outputs']['run_record_mb']} MB; {state['outcome']}"
