@@ -139,3 +139,21 @@ def test_departed_fragments_leave_the_outcomes_as_they_were(tmp_path):
     for measure in ("f_gro", "N_lar_over_N", "N_cum_le_1_over_N", "N_cum_le_4_over_N",
                     "N_cum_le_16_over_N"):
         assert case[measure]["agree"], measure
+
+
+def test_the_paper_size_study_runs_end_to_end_in_small(tmp_path):
+    # validation/paper_size.py through the user's commands at 2 x 300 grains, the frictional
+    # 20 m/s scene with dt from --dt auto --tolerance 1e-3: it sticks (3D BPCA paper, Fig. 2:
+    # f_gro near 1 well below v_fra), the energy error keeps the tolerance dt was chosen for,
+    # and the stages and the record are measured
+    subprocess.run([sys.executable, str(ROOT / "validation" / "paper_size.py"), "--n", "300",
+                    "--only", "sticking", "--limit-minutes", "5", "--runs", str(tmp_path / "runs"),
+                    "--results", str(tmp_path / "results")], check=True, timeout=600,
+                   capture_output=True)
+    state = json.loads((tmp_path / "results" / "sticking" / "stages.json").read_text())
+    assert state["outcome"]["stop_reason"] == "settled"
+    assert state["outcome"]["growth_efficiency"] > 0.9
+    assert state["outcome"]["energy_error"] < 1e-3
+    assert all(state[stage]["seconds"] > 0 for stage in ("setup", "run", "analyse"))
+    assert state["run"]["per_check"]["memory_mb_last"] > 0
+    assert 0 < state["outputs"]["run_record_mb"] < 5
