@@ -39,6 +39,7 @@
 #include "utils.h"
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 using namespace LAMMPS_NS;
