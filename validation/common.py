@@ -12,6 +12,14 @@ from pathlib import Path
 BIN = Path(sys.executable).parent
 
 
+def loop_seconds(run: Path) -> float:
+    """The wall time LAMMPS spent in the runs of a run directory (its log's 'Loop time')."""
+    from jkrdt.scene import LOG
+
+    return sum(float(m.group(1)) for m in
+               re.finditer(r"Loop time of ([0-9.eE+-]+)", (run / LOG).read_text()))
+
+
 def campaign_paths(specs: dict[str, dict], runs: Path) -> dict[str, Path]:
     """The directory of each spec's campaign below ``runs`` (its spec beside it, .json)."""
     return {name: runs / re.sub(r"[^A-Za-z0-9.]+", "_", name) for name in specs}

@@ -29,10 +29,10 @@ from pathlib import Path
 
 import numpy as np
 
-from common import campaign_paths, run_campaigns
+from common import campaign_paths, loop_seconds, run_campaigns
 from jkrdt.analysis import dumps, fragments
 from jkrdt.analysis.tables import write_csv
-from jkrdt.scene import CONTACTS
+from jkrdt.scene import CONTACTS, LOG, META
 
 HERE = Path(__file__).resolve().parent
 FULL = dict(n=1000, seeds=list(range(1, 9)), v_col=[20.0, 39.8, 100.0],
@@ -51,8 +51,8 @@ def spec(model: str, depart: str, plan: dict) -> dict:
 
 def wrong_departures(run: Path) -> tuple[int, int]:
     """(fragments the rule would have let go, of them not whole at the end) of a shadow run."""
-    would = [tuple(map(int, m.groups())) for m in WOULD.finditer((run / "log.lammps").read_text())]
-    meta = json.loads((run / "collision.json").read_text())
+    would = [tuple(map(int, m.groups())) for m in WOULD.finditer((run / LOG).read_text())]
+    meta = json.loads((run / META).read_text())
     ids = np.arange(1, meta["N_tar"] + meta["N_pro"] + 1)
     pairs = dumps.last_local_snapshot(run / CONTACTS)[:, :2].astype(np.int64)
     labels = fragments.from_contacts(ids, pairs)
@@ -62,11 +62,6 @@ def wrong_departures(run: Path) -> tuple[int, int]:
     wrong = sum(1 for _, label, size in would
                 if smallest[labels[label - 1]] != label or sizes[labels[label - 1]] != size)
     return len(would), wrong
-
-
-def loop_seconds(run: Path) -> float:
-    return sum(float(m.group(1)) for m in
-               re.finditer(r"Loop time of ([0-9.eE+-]+)", (run / "log.lammps").read_text()))
 
 
 def rows_of(where: Path, model: str, depart: str) -> list[dict]:

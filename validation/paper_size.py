@@ -34,6 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
+from common import loop_seconds
 from jkrdt import scene as scene_module
 from jkrdt.analysis.tables import read_csv
 
@@ -103,24 +104,28 @@ def study(name: str, n: int, ranks: int, runs: Path, results: Path,
     run.mkdir(parents=True, exist_ok=True)
     state_path = run / "stage.json"
     state = json.loads(state_path.read_text()) if state_path.exists() else {}
+
+    def save() -> None:           # after each stage: a second call skips what is done
+        state_path.write_text(json.dumps(state, indent=2))
+
     scene = SCENES[name]
     if "setup" not in state:
         state["setup"] = timed([BIN / "jkrdt", "setup", "--n-tar", n, "--n-pro", n,
                                 "--v", scene["v"], "--model", scene["model"], "--b-off", 0,
                                 "--seed", 1, "--dt", "auto", "--tolerance", "1e-3",
                                 "--out", run, "--force"], run / "stage.setup")
-        state_path.write_text(json.dumps(state, indent=2))
+        save()
     if "run" not in state:
         state["run"] = timed([BIN / "jkrdt", "run", run, "--np", ranks], run / "stage.run",
                              limit=limit)
         state["run"]["lammps_memory_per_rank_mb"] = lammps_memory(run / scene_module.LOG)
         state["run"]["ranks"] = ranks
-        state_path.write_text(json.dumps(state, indent=2))
+        save()
     if "analyse" not in state:
         partial = ["--partial"] if state["run"].get("cut_at_limit") else []
         state["analyse"] = timed([BIN / "jkrdt", "analyse", run, *partial],
                                  run / "stage.analyse")
-        state_path.write_text(json.dumps(state, indent=2))
+        save()
     out = json.loads((run / "outcome.json").read_text())
     state["outputs"] = output_sizes(run)
     state["scene"] = dict(n_tar=n, n_pro=n, **scene, b_off=0.0, seed=1,
@@ -131,11 +136,9 @@ def study(name: str, n: int, ranks: int, runs: Path, results: Path,
         "n_fragments", "growth_efficiency", "gyration_radius_largest",
         "contacts_per_particle", "kinetic_left", "kinetic_departed", "energy_error",
         "dissipated_fraction")}
-    log = (run / scene_module.LOG).read_text()
-    loops = [float(m) for m in re.findall(r"Loop time of ([0-9.eE+-]+)", log)]
-    state["run"]["loop_seconds"] = sum(loops)
+    state["run"]["loop_seconds"] = loop_seconds(run)
     state["run"]["per_check"] = per_check(run / scene_module.CHECKS)
-    state_path.write_text(json.dumps(state, indent=2))
+    save()
     target = results / name
     target.mkdir(parents=True, exist_ok=True)
     for kept in KEPT:

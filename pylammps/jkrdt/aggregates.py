@@ -93,15 +93,12 @@ class _RayGrid:
         row = self.slots[(i * self.side + j) * self.side + k]
         return row[row >= 0]
 
-    def listed(self, points: np.ndarray, groups: np.ndarray | None = None):
-        """Grain indices listed in the cells of ``points`` (m, 3), with repeats; with
-        ``groups`` (m,), also the group of the point each was found from."""
+    def listed(self, points: np.ndarray, groups: np.ndarray):
+        """Grain indices listed in the cells of ``points`` (m, 3), with repeats, and the
+        group (``groups``, (m,)) of the point each was found from."""
         idx = np.floor((points - self.low) / self.cell).astype(np.int64)
         inside = ((idx >= 0) & (idx < self.side)).all(axis=1)
         cells = (idx[inside, 0] * self.side + idx[inside, 1]) * self.side + idx[inside, 2]
-        if groups is None:
-            found = self.slots[np.unique(cells)]
-            return found[found >= 0]
         key = np.unique(groups[inside] * self.side ** 3 + cells)
         found = self.slots[key % self.side ** 3]
         keep = found >= 0
@@ -110,6 +107,16 @@ class _RayGrid:
 
 #: lines thrown at once: their first touches are found together, then taken in turn
 BPCA_LINES = 64
+
+
+def _first_touch(rel: np.ndarray, u: np.ndarray, contact: float) -> np.ndarray:
+    """For lines start + t u (unit u) and grains at start - ``rel``: the least t at which
+    the line comes within ``contact`` of the grain, |rel + t u| = contact; inf where it
+    misses. Rows of ``rel`` and ``u`` pair up (or broadcast)."""
+    b = (rel * u).sum(axis=-1)
+    disc = b * b - ((rel ** 2).sum(axis=-1) - contact ** 2)
+    with np.errstate(invalid="ignore"):
+        return np.where(disc >= 0, -b - np.sqrt(disc), np.inf)
 
 
 def bpca(n: int, radius: float, delta0: float, rng: np.random.Generator, dim: int = 3,
@@ -153,14 +160,11 @@ def bpca(n: int, radius: float, delta0: float, rng: np.random.Generator, dim: in
         offsets = np.arange(0.0, 2 * span + contact, step)
         points = (starts[:, None, :] + offsets[None, :, None] * u[:, None, :]).reshape(-1, 3)
         cand, line = grains.listed(points, np.repeat(np.arange(BPCA_LINES), len(offsets)))
-        rel = starts[line] - grains.x[cand]
-        b = (rel * u[line]).sum(axis=1)
-        disc = b * b - ((rel ** 2).sum(axis=1) - contact ** 2)
-        hit = disc >= 0
-        cand, line = cand[hit], line[hit]
+        along = _first_touch(starts[line] - grains.x[cand], u[line], contact)
+        hit = np.isfinite(along)
+        cand, line, along = cand[hit], line[hit], along[hit]
         t = np.full(BPCA_LINES, np.inf)
         target = np.zeros(BPCA_LINES, dtype=np.int64)
-        along = -b[hit] - np.sqrt(disc[hit])
         order = np.lexsort((along, line))
         hitting, first = np.unique(line[order], return_index=True)
         t[hitting], target[hitting] = along[order[first]], cand[order[first]]
@@ -182,12 +186,8 @@ def bpca(n: int, radius: float, delta0: float, rng: np.random.Generator, dim: in
             if k == n or math.dist(new, centre) + contact > span:
                 break             # done, or the disc no longer covers the cluster
             # the new grain may come first on the lines still to be taken
-            rel = starts[j + 1:] - new
-            b_new = (rel * u[j + 1:]).sum(axis=1)
-            disc_new = b_new * b_new - ((rel ** 2).sum(axis=1) - contact ** 2)
-            with np.errstate(invalid="ignore"):
-                t_new = -b_new - np.sqrt(disc_new)
-            sooner = t_new < t[j + 1:]                  # False where it misses (NaN)
+            t_new = _first_touch(starts[j + 1:] - new, u[j + 1:], contact)
+            sooner = t_new < t[j + 1:]
             t[j + 1:][sooner] = t_new[sooner]
             target[j + 1:][sooner] = k - 1
     x = grains.x[:n]
@@ -210,12 +210,9 @@ def bpca_plain(n: int, radius: float, delta0: float, rng: np.random.Generator,
         w /= np.linalg.norm(w)
         r = rng.random()
         start = centre - span * u + span * (np.sqrt(r) if dim == 3 else 2 * r - 1) * w
-        rel = start - x
-        b = rel @ u
-        disc = b * b - ((rel ** 2).sum(axis=1) - contact ** 2)
-        if not (disc >= 0).any():
+        t = _first_touch(start - x, u, contact)
+        if not np.isfinite(t).any():
             continue
-        t = np.where(disc >= 0, -b - np.sqrt(np.abs(disc)), np.inf)
         k = np.argmin(t)
         new = x[k] + (start + t[k] * u - x[k]) * (bond / contact)
         if np.count_nonzero(np.linalg.norm(x - new, axis=1) <= contact) == 1:
