@@ -258,6 +258,18 @@ int FixJKRDTContacts::setmask()
 }
 
 /* ----------------------------------------------------------------------
+   before atoms migrate: the state into the per-atom rows, and the pair
+   style's bins fitted to the box
+------------------------------------------------------------------------- */
+
+void FixJKRDTContacts::pre_exchange()
+{
+  to_rows();
+  auto *pair = dynamic_cast<PairJKRDT *>(force->pair_match("jkr/dt", 1, 0));
+  if (pair) pair->fit_bins(neighbor->cutneighmax);
+}
+
+/* ----------------------------------------------------------------------
    after every neighbor list build: the slots of the pair's new list
 ------------------------------------------------------------------------- */
 

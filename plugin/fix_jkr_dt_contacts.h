@@ -71,8 +71,8 @@ class FixJKRDTContacts : public Fix {
   ~FixJKRDTContacts() override;
   int setmask() override;
   void init() override;
-  void setup_pre_exchange() override { to_rows(); }
-  void pre_exchange() override { to_rows(); }
+  void setup_pre_exchange() override { pre_exchange(); }
+  void pre_exchange() override;
   void setup_post_neighbor() override { post_neighbor(); }
   void post_neighbor() override;
   void check_atoms(bigint natoms_before);

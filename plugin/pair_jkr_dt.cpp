@@ -61,7 +61,8 @@ const char *const PairJKRDT::DEPARTED_GROUP = "jkrdt_departed";
 /* ---------------------------------------------------------------------- */
 
 PairJKRDT::PairJKRDT(LAMMPS *lmp) :
-    Pair(lmp), fix_contacts(nullptr), departed_bit(0), threads_logged(0), nstride(0),
+    Pair(lmp), fix_contacts(nullptr), departed_bit(0), bins_bounded(true), bin_size_set(0.0),
+    bin_size_logged(0.0), threads_logged(0), nstride(0),
     dt_check(DT_CHECK_ERROR), tc_min(0.0), tc_types{0, 0}, tc_logged(0.0), dt_logged(0.0),
     dt_warned(0.0), checked_laststep(-1), step_max(0.0),
     step_warned(false), contacts_at_run_end(0), data_contacts(0)
@@ -147,6 +148,7 @@ void PairJKRDT::init_style()
   departed_bit = departed >= 0 ? group->bitmask[departed] : 0;
 
   neighbor->add_request(this, NeighConst::REQ_NEWTON_OFF);
+  fit_bins(cutmax + neighbor->skin);
 
   const int nthreads = nthreads_used();
   if (comm->me == 0 && nthreads != threads_logged)

@@ -2,7 +2,8 @@
    energy-conserving by Wada et al. (2007).
 
    This class is the LAMMPS glue: coefficients and their mixing
-   (pair_jkr_dt_coeff.cpp), the neighbor-list loop, contact formation and
+   (pair_jkr_dt_coeff.cpp), bins that grow with the box (pair_jkr_dt_bins.cpp),
+   the neighbor-list loop, contact formation and
    breaking, energy and dissipation bookkeeping (pair_jkr_dt.cpp). The
    contact physics lives in jkr_dt_normal.h; the contact state in
    FixJKRDTContacts.                                                        */
@@ -89,6 +90,10 @@ class PairJKRDT : public Pair {
   // the contact store with its per-atom rows current (for readers between the steps)
   FixJKRDTContacts *contacts();
   void report_lost_contact();    // a stored contact missing from the neighbor list
+  // bins that grow with the box (pair_jkr_dt_bins.cpp); before each reneighboring
+  static constexpr double BINS_PER_GRAIN = 32.0;
+  // cutneigh: the neighbor cutoff (Neighbor's cutneighmax once it is set up)
+  void fit_bins(double cutneigh);
 
  protected:
   std::vector<Input> input;    // (ntypes+1)^2, row-major
@@ -112,6 +117,9 @@ class PairJKRDT : public Pair {
   bigint data_contacts;        // contacts a data file read by read_data left behind
   FixJKRDTContacts *fix_contacts;
   int departed_bit;            // mask bit of DEPARTED_GROUP; 0 while the group does not exist
+  bool bins_bounded;           // pair_style ... bins bounded (default) or box
+  double bin_size_set;         // the neighbor and sort bin size fit_bins() set last (0: LAMMPS's)
+  double bin_size_logged;      // the bin size last written to the log
 
   int nstride;                 // ntypes + 1
   Input &in(int i, int j) { return input[i * nstride + j]; }

@@ -50,8 +50,9 @@ static bool given(double x) { return !std::isnan(x); }
 
 void PairJKRDT::settings(int narg, char **arg)
 {
-  // pair_style jkr/dt [dt_check error|warn|off]
+  // pair_style jkr/dt [dt_check error|warn|off] [bins bounded|box]
   dt_check = DT_CHECK_ERROR;
+  bins_bounded = true;
   data_contacts = 0;    // the deliberate fresh start from a marked data file
   if (fix_contacts && !modify->get_fix_by_id(FIX_ID)) {    // given anew after an unfix
     fix_contacts = nullptr;
@@ -59,17 +60,25 @@ void PairJKRDT::settings(int narg, char **arg)
   }
   for (int iarg = 0; iarg < narg; iarg += 2) {
     const std::string key = arg[iarg];
-    if (key != "dt_check")
-      error->all(FLERR,
-                 "pair_style jkr/dt: unknown setting '{}'; the only one is 'dt_check "
-                 "error|warn|off' (material parameters go in pair_coeff)",
-                 key);
     const std::string value = (iarg + 1 < narg) ? arg[iarg + 1] : "";
-    if (value == "error") dt_check = DT_CHECK_ERROR;
-    else if (value == "warn") dt_check = DT_CHECK_WARN;
-    else if (value == "off") dt_check = DT_CHECK_OFF;
-    else
-      error->all(FLERR, "pair_style jkr/dt: dt_check takes error, warn or off (got '{}')", value);
+    if (key == "dt_check") {
+      if (value == "error") dt_check = DT_CHECK_ERROR;
+      else if (value == "warn") dt_check = DT_CHECK_WARN;
+      else if (value == "off") dt_check = DT_CHECK_OFF;
+      else
+        error->all(FLERR, "pair_style jkr/dt: dt_check takes error, warn or off (got '{}')",
+                   value);
+    } else if (key == "bins") {
+      if (value == "bounded") bins_bounded = true;
+      else if (value == "box") bins_bounded = false;
+      else
+        error->all(FLERR, "pair_style jkr/dt: bins takes bounded or box (got '{}')", value);
+    } else {
+      error->all(FLERR,
+                 "pair_style jkr/dt: unknown setting '{}'; the settings are 'dt_check "
+                 "error|warn|off' and 'bins bounded|box' (material parameters go in pair_coeff)",
+                 key);
+    }
   }
 }
 

