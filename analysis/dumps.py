@@ -20,6 +20,7 @@ import dataclasses
 import gzip
 import tempfile
 import warnings
+import weakref
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -59,8 +60,12 @@ def atoms_universe(path, columns=("radius", "c_coord", DEPARTED_AT)):
                                 additional_columns=extra, dt=1.0)
         except EOFError:
             readable = _readable_part(path)
-            return mda.Universe(str(readable), format="LAMMPSDUMP",
-                                topology_format="LAMMPSDUMP", additional_columns=extra, dt=1.0)
+            universe = mda.Universe(str(readable), format="LAMMPSDUMP",
+                                    topology_format="LAMMPSDUMP", additional_columns=extra,
+                                    dt=1.0)
+            # the copy lives as long as the universe that reads it (or to the exit)
+            weakref.finalize(universe, readable.unlink, missing_ok=True)
+            return universe
 
 
 def _readable_part(path: Path) -> Path:

@@ -6,7 +6,9 @@ analysis finds independently in the dumps: over the window that let the run stop
 fragments did not change, and the plugin's union-find over all ranks gives the same
 N_lar and number of fragments as analysis.fragments on the contact dump."""
 
+import gc
 import subprocess
+import tempfile
 import sys
 from pathlib import Path
 
@@ -160,5 +162,9 @@ def test_truncated_dump_is_refused_unless_partial(settled, tmp_path, cut):
     (run / cut).write_bytes(data[: int(0.97 * len(data))])   # killed while writing
     with pytest.raises(RunNotComplete, match=r"the dumps end at step \d+, before the run's end"):
         analyse_run(run, plots=False)
+    copies = lambda: set(Path(tempfile.gettempdir()).glob(f"{cut}.*.readable"))
+    before = copies()
     out = analyse_run(run, plots=False, partial=True)
     assert out["stop_reason"] == "cut off" and out["last_step"] < out["stop_step"]
+    gc.collect()
+    assert copies() <= before, "the readable copy of a cut-off dump outlived its reader"
