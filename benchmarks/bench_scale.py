@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import re
 import subprocess
 import sys
@@ -35,83 +34,13 @@ import tempfile
 import time
 from pathlib import Path
 
+from side_by_side import alternate
+
 HERE = Path(__file__).resolve().parent
 BIN = Path(sys.executable).parent
-VARIANTS = {"before": dict(bins="box", balance="no"), "after": {}}
-
-
-def dir_mb(path: Path) -> float:
-    return sum(f.stat().st_size for f in path.iterdir() if f.is_file()) / 2**20
-
-
-def worker(scene: str, variables: str) -> None:
-    """Run ``scene`` chunk by chunk on request: a line on stdin runs one check interval
-    and answers one JSON line on stdout; 'quit' ends."""
-    from lammps import LMP_STYLE_GLOBAL, LMP_TYPE_VECTOR
-
-    from jkrdt.session import Session
-    from jkrdt.stopping import DEFAULT_RULE
-
-    out = Path(tempfile.mkdtemp(prefix="bench_scale_"))
-    with Session(scene, settle=DEFAULT_RULE, out=out,
-                 variables=dict(json.loads(variables), outputs="yes")) as s:
-        natoms = int(s.lmp.get_natoms())
-        tc = s.scene.scales.t_c
-        for line in sys.stdin:
-            if line.strip() == "quit":
-                break
-            t0 = time.perf_counter()
-            s.lmp.command(f"run {s.check} pre no post no")
-            wall = time.perf_counter() - t0
-            lo, hi = s.lmp.extract_box()[:2]
-            vec = lambda k: s.lmp.extract_fix("settle", LMP_STYLE_GLOBAL, LMP_TYPE_VECTOR, k)
-            status = Path("/proc/self/status").read_text()
-            rss = int(re.search(r"VmRSS:\s+(\d+)", status).group(1)) / 1024
-            print(json.dumps(dict(
-                t_tc=s.lmp.get_thermo("time") / tc, wall=wall,
-                us_per_atom_step=1e6 * wall / (natoms * s.check),
-                box=[h - l for l, h in zip(lo, hi)], rss_mb=rss, out_mb=dir_mb(out),
-                departed=vec(5), state=("running", "settled", "cap")[int(vec(0))])),
-                flush=True)
-
-
-def side_by_side(scene: Path, until_tc: float, budget: float) -> dict:
-    procs = {d: subprocess.Popen([sys.executable, __file__, "--worker", str(scene),
-                                  json.dumps(v)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                                 text=True)
-             for d, v in VARIANTS.items()}
-    series = {d: [] for d in procs}
-    spent = {d: 0.0 for d in procs}
-    loads = []
-    live = dict(procs)
-    while live:
-        for d in list(live):                    # A B A B: one chunk each in turn
-            p = live[d]
-            p.stdin.write("step\n")
-            p.stdin.flush()
-            row = json.loads(p.stdout.readline())
-            series[d].append(row)
-            spent[d] += row["wall"]
-            loads.append(os.getloadavg()[0])
-            if row["state"] != "running" or row["t_tc"] >= until_tc or spent[d] > budget:
-                p.stdin.write("quit\n")
-                p.stdin.flush()
-                p.wait()
-                del live[d]
-            print(f"{d:6s} t = {row['t_tc']:7.0f} t_c  {row['us_per_atom_step']:.3f} us/atom-step"
-                  f"  box {' x '.join(f'{b * 1e6:.1f}' for b in row['box'])} um"
-                  f"  RSS {row['rss_mb']:.0f} MB  out {row['out_mb']:.1f} MB", flush=True)
-
-    def verdict(rows):
-        first = rows[0]
-        return dict(chunks=len(rows), end_t_tc=rows[-1]["t_tc"], end_state=rows[-1]["state"],
-                    cost_first=first["us_per_atom_step"],
-                    cost_max_ratio=max(r["us_per_atom_step"] for r in rows) / first["us_per_atom_step"],
-                    cost_end_ratio=rows[-1]["us_per_atom_step"] / first["us_per_atom_step"],
-                    rss_first=first["rss_mb"], rss_max_ratio=max(r["rss_mb"] for r in rows) / first["rss_mb"],
-                    out_mb=rows[-1]["out_mb"], wall_total=sum(r["wall"] for r in rows))
-    return dict(load_average=[min(loads), max(loads)],
-                summary={d: verdict(series[d]) for d in series}, series=series)
+# both write the deck's full record (its size is measured)
+VARIANTS = {"before": dict(bins="box", balance="no", outputs="yes"),
+            "after": dict(outputs="yes")}
 
 
 # a check interval per run command, so that LAMMPS reports the ranks' grains after each
@@ -171,10 +100,7 @@ def main(argv=None) -> None:
     ap.add_argument("--balance-tc", type=float, default=1000.0, help="simulated time, part 2")
     ap.add_argument("--quick", action="store_true", help="2 x 300, 200 t_c, 2 ranks")
     ap.add_argument("--out", type=Path, default=HERE / "scale" / "scale.json")
-    ap.add_argument("--worker", nargs=2, metavar=("SCENE", "VARIABLES"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
-    if args.worker:
-        return worker(*args.worker)
     if args.quick:
         args.sizes, args.until_tc, args.ranks = [300], 200.0, [2]
         args.balance_n, args.balance_tc = 300, 200.0
@@ -196,7 +122,7 @@ def main(argv=None) -> None:
                           b_off=0.0), variants=VARIANTS, sizes={}, ranks={})
     for n in args.sizes:
         print(f"== 2 x {n}: before and after, side by side", flush=True)
-        out["sizes"][str(n)] = side_by_side(scene(n), args.until_tc, args.budget)
+        out["sizes"][str(n)] = alternate(scene(n), VARIANTS, args.until_tc, args.budget)
         save(args.out, out)
     for ranks in args.ranks:
         print(f"== 2 x {args.balance_n} on {ranks} ranks", flush=True)

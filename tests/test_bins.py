@@ -21,17 +21,22 @@ BINS_PER_GRAIN = 32          # PairJKRDT::BINS_PER_GRAIN
 V_REL = 3.0                  # m/s, head-on, each pair
 
 
-def far_pairs_scene(lmp, gap, settings=""):
-    """Two head-on pairs of ice grains, ``gap`` apart along x, y and z, in a
-    shrink-wrapped box: 4 grains in a box of about gap^3."""
-    s = scales(ICE, R)
-    lmp.commands_string(f"""
+# shrink-wrapped, as a collision scene's box is
+SHRINK_WRAPPED = """
         units si
         atom_style sphere
         atom_modify map array
         boundary m m m
         newton off
         comm_modify vel yes
+"""
+
+
+def far_pairs_scene(lmp, gap, settings=""):
+    """Two head-on pairs of ice grains, ``gap`` apart along x, y and z, in a
+    shrink-wrapped box: 4 grains in a box of about gap^3."""
+    s = scales(ICE, R)
+    lmp.commands_string(SHRINK_WRAPPED + f"""
         region box block {-R!r} {gap + 3.02 * R!r} {-R!r} {gap + R!r} {-R!r} {gap + R!r}
         create_box 1 box
         create_atoms 1 single 0 0 0
@@ -116,14 +121,8 @@ def test_compact_scene_keeps_lammps_bins(lmp, tmp_path):
     # 6^3 grains at rest on a cubic lattice 2.05 r apart: LAMMPS's bins of half the
     # cutoff number (1.23 + 0.41)^3 / 0.101^3 ~ 4300 < 32 x 216, so none widens
     s = scales(ICE, R)
-    lmp.commands_string(f"""
-        log {tmp_path / 'log.lammps'}
-        units si
-        atom_style sphere
-        atom_modify map array
-        boundary m m m
-        newton off
-        comm_modify vel yes
+    lmp.command(f"log {tmp_path / 'log.lammps'}")
+    lmp.commands_string(SHRINK_WRAPPED + f"""
         lattice sc {2.05 * R!r}
         region box block 0 6 0 6 0 6
         create_box 1 box
