@@ -55,7 +55,7 @@ def run_deck(workdir, data, model, nproc=1, steps=STEPS, restart=None, extra=(),
     # 2 cores) would otherwise spin against each other
     env = dict(os.environ, OMP_NUM_THREADS=str(threads), OMP_WAIT_POLICY="PASSIVE")
     subprocess.run(cmd, check=True, cwd=workdir, timeout=600, env=env)
-    final = np.loadtxt(workdir / "final.dump", skiprows=9)
+    final = np.loadtxt(workdir / scene_module.FINAL_DUMP, skiprows=9)
     return final[np.argsort(final[:, 0])]
 
 
@@ -79,7 +79,7 @@ def serial_dir(scene, model, tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def serial(serial_dir):
-    final = np.loadtxt(serial_dir / "final.dump", skiprows=9)
+    final = np.loadtxt(serial_dir / scene_module.FINAL_DUMP, skiprows=9)
     return final[np.argsort(final[:, 0])]
 
 

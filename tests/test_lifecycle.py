@@ -113,7 +113,7 @@ def test_scene_deck_continues_a_restart_with_the_scenes_model_and_dt(tmp_path):
         subprocess.run([str(BIN / "lmp"), "-in", "in.collision.lmp", "-screen", "none",
                         "-var", "settle", "no", "-var", "every", "1000", *extra], cwd=where,
                        check=True, timeout=300)
-        final = np.loadtxt(where / "final.dump", skiprows=9)
+        final = np.loadtxt(where / scene_module.FINAL_DUMP, skiprows=9)
         return final[np.argsort(final[:, 0])]
 
     straight = lmp_in(runs["straight"], "-var", "steps", "4000")
@@ -222,8 +222,10 @@ def lone_grain_and_stuck_pair(lmp):
 def sliding_spinning_pair_and_a_lone_grain(lmp, renumber=None):
     """Atoms 1 and 2 stuck, 2 at lower x than 1, sliding and spinning (pointers and twist
     loaded); atom 3 alone far off at the lowest x. 300 steps, ``renumber``, 300 steps;
-    returns ids, positions and spins ordered by x, and the ledger."""
-    two_grain_scene(lmp, -(2 * R_GRAIN - S.delta0), coeff_extra="xi_crit 8e-10")
+    returns ids, positions and spins ordered by x, and the ledger. LAMMPS's own bins
+    (bins box): reset_atoms sorts by them, and the IDs asserted below follow that order."""
+    two_grain_scene(lmp, -(2 * R_GRAIN - S.delta0), coeff_extra="xi_crit 8e-10",
+                    settings="bins box")
     lmp.command("create_atoms 1 single -1e-6 0 0")
     lmp.command("set atom 3 diameter 2e-7 density 1000")
     lmp.command("set atom 1 omega 2e6 1e6 3e6")

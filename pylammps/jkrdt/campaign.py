@@ -188,10 +188,6 @@ def claim(directory: Path):
     return f
 
 
-#: restart files of a run, written alternately at every check (inputs/collision.lmp)
-RESTARTS = ("restart.a", "restart.b")
-
-
 def resume_point(directory: Path):
     """(restart file, its step) to continue a cut-off run from, or None: the newer restart
     file that LAMMPS reads whole (a file cut off while being written is passed over)."""
@@ -201,7 +197,7 @@ def resume_point(directory: Path):
 
     if not (directory / "collision.json").exists():
         return None
-    found = sorted((p for p in (directory / name for name in RESTARTS) if p.exists()),
+    found = sorted((p for p in (directory / name for name in scene_module.ROLLING_RESTARTS) if p.exists()),
                    key=lambda p: p.stat().st_mtime, reverse=True)
     for path in found:
         lmp = start_lammps(MPI.COMM_SELF)
@@ -266,7 +262,7 @@ def prepare(directory: Path, scene: Scene, aggregates: dict):
     cut back to that step; or None after writing the scene afresh."""
     from jkrdt.analysis.status import run_status
 
-    if (directory / "final.restart").exists() and (directory / "collision.json").exists():
+    if (directory / scene_module.FINAL_RESTART).exists() and (directory / "collision.json").exists():
         status = run_status(directory)
         if status.problem is None and status.stop_reason != "error":
             return "ended"

@@ -44,10 +44,15 @@ ATOMS, CONTACTS, CHECKS, LOG = "atoms.dump.gz", "contacts.dump.gz", "checks.csv"
 #: the outputs a new run of a scene replaces; LAMMPS appends to none of them, but a run
 #: that fails early would leave the last run's behind
 RUN_OUTPUTS = (ATOMS, CONTACTS, CHECKS, LOG)
+#: the end state (written at the end of a run: the restart file, and the grains with their
+#: spins, compressed) and the restart files of a run under way, written alternately at
+#: every check
+FINAL_RESTART, FINAL_DUMP = "final.restart", "final.dump.gz"
+ROLLING_RESTARTS = ("restart.a", "restart.b")
 #: what a scene directory holds once set up, run and analysed (all that a fresh scene clears)
 SCENE_FILES = (DATA, META, DECK, *RUN_OUTPUTS, "frames.csv", "outcome.json", "outcome.png",
                "outcome.pdf", "energy.png", "energy.pdf", "timeline.png", "timeline.pdf",
-               "restart.a", "restart.b", "final.restart", "final.dump")
+               *ROLLING_RESTARTS, FINAL_RESTART, FINAL_DUMP)
 
 
 def pair_coeff(mat: Material, model: str = "frictional") -> str:

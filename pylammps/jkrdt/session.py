@@ -215,7 +215,7 @@ class Session:
 
     def finish(self) -> None:
         """End the run as the scene's deck does after its ``run`` (the part from its
-        ``label finish``): the last frames, final.restart and final.dump, and the rolling
+        ``label finish``): the last frames, final.restart and final.dump.gz, and the rolling
         restart files removed. A session with outputs does this when it closes after no
         error; the dumps end here."""
         if self._finished:
@@ -230,15 +230,17 @@ class Session:
         self.lmp.commands_string(text[start.end():end.start()])
 
     def write_restart(self, path=None) -> Path:
-        path = Path(path) if path is not None else self.out / "final.restart"
+        path = Path(path) if path is not None else self.out / scene_module.FINAL_RESTART
         self.lmp.command(f"write_restart {path}")
         return path
 
     def write_dump(self, path=None) -> Path:
-        """The final state as the deck writes it (id x y z vx vy vz omega, sorted)."""
-        path = Path(path) if path is not None else self.out / "final.dump"
-        self.lmp.command(f"write_dump all custom {path} id x y z vx vy vz omegax omegay omegaz "
-                         "modify sort id format float %.17g")
+        """The final state as the deck writes it (id x y z vx vy vz omega, sorted;
+        compressed when the name ends in .gz)."""
+        path = Path(path) if path is not None else self.out / scene_module.FINAL_DUMP
+        style = "custom/gz" if path.suffix == ".gz" else "custom"
+        self.lmp.command(f"write_dump all {style} {path} id x y z vx vy vz omegax omegay "
+                         "omegaz modify sort id format float %.17g")
         return path
 
     def close(self) -> None:
