@@ -8,11 +8,11 @@ interval (50 t_c) at a time, taking turns (A B A B ...), so both see the same lo
 ``balance rcb``). Both depart fragments and write the deck's full record. Per chunk: us
 per atom-step, box, resident memory, the run directory's size.
 
-Part 2, the ranks: the "after" deck on 2, 4 and 8 ranks (more ranks than cores is fine:
-the numbers are counts, not times) over the first ``--balance-tc`` t_c, one check
-interval per run command; per chunk, the imbalance LAMMPS reports (the largest rank's
-grains over the mean, from the run's "Nlocal" line) and fix balance's own weighted
-factor, before its last rebalance.
+Part 2, the ranks: the deck on 2, 4 and 8 ranks, balancing (its default, rcb) and not
+(``balance no``), over the first ``--balance-tc`` t_c (more ranks than cores is fine: the
+numbers are counts, not times), one check interval per run command; per chunk, the
+imbalance LAMMPS reports (the largest rank's grains over the mean, from the run's
+"Nlocal" line) and fix balance's own weighted factor before its last rebalance.
 
     ./run bench-scale                               # 2 x 2500 and 2 x 25000
     ./run bench-scale --sizes 2500 --until-tc 1000  # shorter
@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import re
 import subprocess
 import sys
@@ -49,37 +50,42 @@ include in.collision.lmp
 variable k loop {chunks}
 label chunk
 run ${{every}} pre no post yes
-print "jkrdt-bench balance $(step) $(f_balance) $(f_balance[3])"
+if "${{balance}} != no" then 'print "jkrdt-bench balance $(step) $(f_balance) $(f_balance[3])"'
+if "${{balance}} == no" then 'print "jkrdt-bench balance $(step) 0 0"'
 next k
 jump SELF chunk
 """
 
 
-def imbalance(scene: Path, ranks: int, balance_tc: float) -> dict:
+def imbalance(scene: Path, ranks: int, balance_tc: float, balance: str = "rcb") -> dict:
     from jkrdt import scene as scene_module
     from jkrdt.stopping import DEFAULT_RULE
 
     sc = scene_module.from_metadata(scene_module.read_metadata(scene))
-    variables = DEFAULT_RULE.deck_variables(sc.time_step(None)[0])
+    variables = dict(DEFAULT_RULE.deck_variables(sc.time_step(None)[0]), balance=balance)
     every = int(variables["every"])
     chunks = max(1, round(balance_tc / DEFAULT_RULE.check_tc))
     deck = scene / "in.bench_balance"
     deck.write_text(BALANCE_DECK.format(chunks=chunks))
     args = [str(BIN / "mpirun"), "-np", str(ranks), str(BIN / "lmp"), "-in", deck.name,
-            "-log", f"log.balance{ranks}", "-screen", "none", "-var", "outputs", "no"]
+            "-log", f"log.balance{ranks}{balance}", "-screen", "none", "-var", "outputs", "no"]
     for name, value in variables.items():
         args += ["-var", name, str(value)]
+    # ranks that sleep while they wait: MPICH's polling would otherwise make more ranks
+    # than cores ~40x slower (8 ranks on 2 cores: 20 s against 0.5 s for 714 steps)
+    env = dict(os.environ, MPIR_CVAR_CH4_PROGRESS_THROTTLE="true",
+               MPIR_CVAR_CH4_PROGRESS_THROTTLE_NO_PROGRESS_COUNT="1")
     start = time.perf_counter()
-    subprocess.run(args, cwd=scene, check=True)
+    subprocess.run(args, cwd=scene, check=True, env=env)
     wall = time.perf_counter() - start
-    log = (scene / f"log.balance{ranks}").read_text()
+    log = (scene / f"log.balance{ranks}{balance}").read_text()
     nlocal = [(float(ave), float(mx)) for ave, mx in
               re.findall(r"^Nlocal:\s+(\S+) ave\s+(\S+) max", log, re.M)]
     fix = [tuple(map(float, m)) for m in
            re.findall(r"^jkrdt-bench balance (\S+) (\S+) (\S+)", log, re.M)]
     rows = [dict(t_tc=(k + 1) * DEFAULT_RULE.check_tc, grains_max_over_mean=mx / ave,
                  fix_after=f[1], fix_before=f[2]) for k, ((ave, mx), f) in enumerate(zip(nlocal, fix))]
-    return dict(ranks=ranks, every=every, wall=wall, series=rows,
+    return dict(ranks=ranks, balance=balance, every=every, wall=wall, series=rows,
                 grains_max_over_mean_max=max(r["grains_max_over_mean"] for r in rows),
                 fix_before_max=max(r["fix_before"] for r in rows))
 
@@ -87,15 +93,16 @@ def imbalance(scene: Path, ranks: int, balance_tc: float) -> dict:
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                  formatter_class=argparse.ArgumentDefaultsHelpFormatter)
-    ap.add_argument("--sizes", type=int, nargs="+", default=[2500, 25000],
-                    help="grains per aggregate, each size side by side")
+    ap.add_argument("--sizes", type=int, nargs="*", default=[2500, 25000],
+                    help="grains per aggregate, each size side by side (none: skip part 1)")
     ap.add_argument("--v", type=float, default=39.8, help="v_col, m/s")
     ap.add_argument("--model", default="frictionless")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--until-tc", type=float, default=3000.0, help="simulated time of part 1")
     ap.add_argument("--budget", type=float, default=1800.0,
                     help="wall seconds after which a variant of part 1 stops")
-    ap.add_argument("--ranks", type=int, nargs="+", default=[2, 4, 8])
+    ap.add_argument("--ranks", type=int, nargs="*", default=[2, 4, 8],
+                    help="rank counts of part 2 (none: skip it)")
     ap.add_argument("--balance-n", type=int, default=2500, help="grains per aggregate, part 2")
     ap.add_argument("--balance-tc", type=float, default=1000.0, help="simulated time, part 2")
     ap.add_argument("--quick", action="store_true", help="2 x 300, 200 t_c, 2 ranks")
@@ -125,11 +132,12 @@ def main(argv=None) -> None:
         out["sizes"][str(n)] = alternate(scene(n), VARIANTS, args.until_tc, args.budget)
         save(args.out, out)
     for ranks in args.ranks:
-        print(f"== 2 x {args.balance_n} on {ranks} ranks", flush=True)
-        out["ranks"][str(ranks)] = imbalance(scene(args.balance_n), ranks, args.balance_tc)
-        print(json.dumps({k: v for k, v in out["ranks"][str(ranks)].items() if k != "series"}),
-              flush=True)
-        save(args.out, out)
+        for balance in ("rcb", "no"):        # the deck's default, and no balancing
+            print(f"== 2 x {args.balance_n} on {ranks} ranks, balance {balance}", flush=True)
+            got = imbalance(scene(args.balance_n), ranks, args.balance_tc, balance)
+            out["ranks"][f"{ranks} {balance}"] = got
+            print(json.dumps({k: v for k, v in got.items() if k != "series"}), flush=True)
+            save(args.out, out)
     print(json.dumps({n: s["summary"] for n, s in out["sizes"].items()}, indent=1))
 
 
