@@ -104,7 +104,7 @@ def test_periodic_box_too_small():
 def test_pair_style_arguments():
     lmp = start_lammps()
     try:
-        with pytest.raises(Exception, match="unknown setting '1.0'; the only one is 'dt_check"):
+        with pytest.raises(Exception, match="unknown setting '1.0'; the settings are 'dt_check"):
             lmp.command("pair_style jkr/dt 1.0")
         with pytest.raises(Exception, match="dt_check takes error, warn or off"):
             lmp.command("pair_style jkr/dt dt_check maybe")
