@@ -84,7 +84,8 @@ def imbalance(scene: Path, ranks: int, balance_tc: float, balance: str = "rcb") 
     fix = [tuple(map(float, m)) for m in
            re.findall(r"^jkrdt-bench balance (\S+) (\S+) (\S+)", log, re.M)]
     rows = [dict(t_tc=(k + 1) * DEFAULT_RULE.check_tc, grains_max_over_mean=mx / ave,
-                 fix_after=f[1], fix_before=f[2]) for k, ((ave, mx), f) in enumerate(zip(nlocal, fix))]
+                 fix_after=f[1], fix_before=f[2])
+            for k, ((ave, mx), f) in enumerate(zip(nlocal, fix))]
     return dict(ranks=ranks, balance=balance, every=every, wall=wall, series=rows,
                 grains_max_over_mean_max=max(r["grains_max_over_mean"] for r in rows),
                 fix_before_max=max(r["fix_before"] for r in rows))

@@ -197,8 +197,9 @@ def resume_point(directory: Path):
 
     if not (directory / "collision.json").exists():
         return None
-    found = sorted((p for p in (directory / name for name in scene_module.ROLLING_RESTARTS) if p.exists()),
-                   key=lambda p: p.stat().st_mtime, reverse=True)
+    rolling = (directory / name for name in scene_module.ROLLING_RESTARTS)
+    found = sorted((p for p in rolling if p.exists()), key=lambda p: p.stat().st_mtime,
+                   reverse=True)
     for path in found:
         lmp = start_lammps(MPI.COMM_SELF)
         try:
@@ -262,7 +263,8 @@ def prepare(directory: Path, scene: Scene, aggregates: dict):
     cut back to that step; or None after writing the scene afresh."""
     from jkrdt.analysis.status import run_status
 
-    if (directory / scene_module.FINAL_RESTART).exists() and (directory / "collision.json").exists():
+    ended = (directory / scene_module.FINAL_RESTART).exists()
+    if ended and (directory / scene_module.META).exists():
         status = run_status(directory)
         if status.problem is None and status.stop_reason != "error":
             return "ended"
