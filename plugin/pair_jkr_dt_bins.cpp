@@ -39,7 +39,6 @@ void PairJKRDT::fit_bins(double cutneigh)
   // itself is recognised by being the last one it set
   if (neighbor->binsizeflag && neighbor->binsize_user != bin_size_set) return;
   const double half_cut = 0.5 * cutneigh;
-  double V = 0.0;
   const int dim = domain->dimension;
   // the binned region: the box and a neighbor cutoff of ghosts on either side
   double L[3] = {domain->xprd + 2.0 * cutneigh, domain->yprd + 2.0 * cutneigh,
@@ -62,16 +61,17 @@ void PairJKRDT::fit_bins(double cutneigh)
     }
     // LAMMPS refuses a bin over 100 times a side of the box (a flat box)
     size = std::min(size, 50.0 * L[0]);
-    V = L[0] * L[1] * (dim == 3 ? L[2] : 1.0);
   }
   neighbor->binsizeflag = size > 0.0 ? 1 : 0;
   neighbor->binsize_user = size;
   if (atom->sortfreq > 0 && (atom->userbinsize == 0.0 || atom->userbinsize == bin_size_set))
     atom->userbinsize = size;
   if (size > 1.25 * bin_size_logged && comm->me == 0) {
+    const double binned = L[0] * L[1] * (dim == 3 ? L[2] : 1.0);    // box and ghost shell
     utils::logmesg(lmp, "pair jkr/dt: bins widened to {:.4g} m ({:.3g} x half the neighbor "
-                        "cutoff) as the box grew to {:.4g} m^{}, to stay within {} per grain\n",
-                   size, size / half_cut, V, dim, BINS_PER_GRAIN);
+                        "cutoff) as the binned region grew to {:.4g} m^{}, to stay within {} "
+                        "per grain\n",
+                   size, size / half_cut, binned, dim, BINS_PER_GRAIN);
     bin_size_logged = size;
   }
   bin_size_set = size;
