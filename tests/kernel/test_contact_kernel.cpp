@@ -82,6 +82,34 @@ static void force_against_eq5()
   }
 }
 
+// eq. (4) inverted: the step's solver (a table and one Newton step) against Newton's method
+// run to convergence from a bound, over d = delta/delta0 from the break point (d_b) to 100,
+// beyond the table's end at 63 too. Relative to y: within 1e-14 one hundredth past the break;
+// within 1e-11 right at it, where the root is double and y moves as sqrt(d - d_b), so that
+// d's own round-off moves y by 1e-8 (the force by 3e-8 F_c, measured 5e-13 F_c at most)
+static void sqrt_radius_solver()
+{
+  const double db = -delta_c_ratio();
+  double near = 0.0, far = 0.0, force = 0.0, residual = 0.0;
+  for (int k = 0; k <= 400000; ++k) {
+    const double t = 10.1 * k / 400000.0;    // t = sqrt(d - d_b): dense at the break
+    const double d = db + t * t;
+    const double y = contact_sqrt_radius(d), ref = contact_sqrt_radius_newton(d);
+    const double rel = std::fabs(y - ref) / ref;
+    (t * t < 0.01 ? near : far) = std::max(t * t < 0.01 ? near : far, rel);
+    force = std::max(force, std::fabs(normal_force_ratio(y) - normal_force_ratio(ref)));
+    if (t * t >= 0.01)
+      residual = std::max(residual, std::fabs(3.0 * y * y * y * y - 2.0 * y - d) / (1.0 + d));
+  }
+  close("eq. (4) solver against Newton, relative, d - d_b >= 0.01", far, 0.0, 1e-14);
+  close("eq. (4) solver against Newton, relative, at the break", near, 0.0, 1e-11);
+  close("eq. (4) solver: force against Newton's, in F_c", force, 0.0, 1e-11);
+  // (the residual's own evaluation rounds each of its terms: ~10 ulp of 1 + d)
+  close("eq. (4) solver: residual |3y^4 - 2y - d| / (1 + d)", residual, 0.0, 2e-15);
+  close("eq. (4) solver at equilibrium (d = 1)", contact_sqrt_radius(1.0), 1.0, 2e-16);
+  close("eq. (4) solver at the break (d = d_b)", contact_sqrt_radius(db), y_break(), 0.0);
+}
+
 // eqs. (36)-(38): a displacement beyond its limit is brought back to the limit, so the
 // force or torque sits at its critical value, and what the clamp dissipates is what the
 // spring lost. The pointer correction of eqs. (42), (A8) is exact to second order in the
@@ -241,6 +269,7 @@ static void elastic_oscillation()
 int main()
 {
   force_against_eq5();
+  sqrt_radius_solver();
   clamps();
   setup_changes_nothing();
   angular_momentum();
