@@ -26,12 +26,12 @@ using namespace LAMMPS_NS;
 /* ---------------------------------------------------------------------- */
 
 FixJKRDTSettle::FixJKRDTSettle(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), window(5), tolerance(0.01), cap(-1.0), state(RUNNING), last_check(-1),
+    Fix(lmp, narg, arg), window(5), tolerance(0.01), counts(1.0e-4), cap(-1.0), state(RUNNING), last_check(-1),
     now{0, 0, 0, 0.0}, depart(DEPART_NO), departed_bit(0), moving_bits(0), quiet_speed(0.0),
     break_energy(0.0), departed_grains(0.0), departed_fragments(0.0), table_append(false),
     table(nullptr), table_start(0.0)
 {
-  const char *usage = "fix ID all jkr/dt/settle N window K tolerance f [cap T] "
+  const char *usage = "fix ID all jkr/dt/settle N window K tolerance f [counts c] [cap T] "
                       "[depart yes|no|shadow] [table FILE] [append yes|no]";
   if (narg < 4) error->all(FLERR, "fix jkr/dt/settle: expected '{}'", usage);
   if (igroup != 0)
@@ -49,6 +49,11 @@ FixJKRDTSettle::FixJKRDTSettle(LAMMPS *lmp, int narg, char **arg) :
       if (!(tolerance >= 0.0 && tolerance < 1.0))
         error->all(FLERR, "fix jkr/dt/settle: tolerance is a fraction in [0, 1) (got {})",
                    tolerance);
+    } else if (key == "counts") {
+      counts = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
+      if (!(counts >= 0.0 && counts < 1.0))
+        error->all(FLERR, "fix jkr/dt/settle: counts is a fraction of all grains in [0, 1) "
+                   "(got {}; 0 asks N_lar and the fragment count to stay unchanged)", counts);
     } else if (key == "cap") {
       cap = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
       if (!(cap > 0.0)) error->all(FLERR, "fix jkr/dt/settle: cap is a simulated time > 0");
@@ -211,15 +216,21 @@ void FixJKRDTSettle::end_of_step()
 
   int reason = RUNNING;
   if (static_cast<int>(history.size()) == window + 1) {
-    bool same = true;
-    bigint lo = now.contacts, hi = now.contacts;
+    // each count's range over the window
+    bigint lo[3] = {now.n_largest, now.n_fragments, now.contacts};
+    bigint hi[3] = {now.n_largest, now.n_fragments, now.contacts};
     for (const auto &h : history) {
-      same = same && h.n_largest == now.n_largest && h.n_fragments == now.n_fragments;
-      lo = std::min(lo, h.contacts);
-      hi = std::max(hi, h.contacts);
+      const bigint of[3] = {h.n_largest, h.n_fragments, h.contacts};
+      for (int k = 0; k < 3; k++) {
+        lo[k] = std::min(lo[k], of[k]);
+        hi[k] = std::max(hi[k], of[k]);
+      }
     }
+    const bigint allowed = static_cast<bigint>(std::floor(counts * atom->natoms));
+    const bool same = hi[0] - lo[0] <= allowed && hi[1] - lo[1] <= allowed;
     const double dissipating = now.dissipated - history.front().dissipated;
-    if (same && (hi - lo) <= tolerance * hi && dissipating <= tolerance * std::fabs(now.dissipated))
+    if (same && (hi[2] - lo[2]) <= tolerance * hi[2] &&
+        dissipating <= tolerance * std::fabs(now.dissipated))
       reason = SETTLED;
   }
   // the cap is met when the next check would lie beyond it

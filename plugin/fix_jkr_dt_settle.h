@@ -1,11 +1,15 @@
 /* jkr/dt: fix jkr/dt/settle, which ends a run when the collision has ended.
 
-     fix ID all jkr/dt/settle N window K tolerance f [cap T] [depart yes|no|shadow]
+     fix ID all jkr/dt/settle N window K tolerance f [counts c] [cap T]
+                              [depart yes|no|shadow]
 
    Every N steps it finds the fragments: the connected components of the
    bonded-contact graph of pair jkr/dt over all ranks. The collision has
-   settled when, over the last K checks (K N steps), the partition has kept
-   its largest fragment N_lar and its number of fragments, the number of
+   settled when, over the last K checks (K N steps), its largest fragment
+   N_lar and its number of fragments have each varied by at most c of all
+   grains, rounded down (default c = 1e-4: unchanged below 10^4 grains, 10
+   grains or fragments of 10^5, where with thousands of fragments in flight
+   some meet at every check; the outcome's N_lar/N holds still to c), the number of
    bonded contacts has varied by at most f of its largest value, and the
    energy dissipated over those K N steps is at most f of all the energy
    dissipated so far (restructuring by rolling and sliding has stopped: a
@@ -84,6 +88,7 @@ class FixJKRDTSettle : public Fix {
  private:
   int window;                    // K checks
   double tolerance;              // f: relative change of the contact count
+  double counts;                 // c: change of N_lar and of the fragment count, of all grains
   double cap;                    // simulated time at which the run stops unsettled; < 0 none
   int state;
   bigint last_check;

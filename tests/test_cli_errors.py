@@ -36,6 +36,7 @@ def one_line_error(args, match, cwd=None):
     (["run", ".", "--steps", "0"], "--steps must be >= 1"),
     (["setup", "--dt", "fast"], "--dt takes a time step in units of t_c or 'auto'"),
     (["demo", "--window", "0"], "settle window must be a whole number of checks >= 1"),
+    (["demo", "--settle-counts", "1"], "settle counts is a fraction of all grains in [0, 1)"),
 ])
 def test_option_errors(tmp_path, args, match):
     one_line_error(args, match, cwd=tmp_path)

@@ -68,6 +68,30 @@ def test_session_stops_when_the_fragments_and_contacts_hold_still(settled):
     assert energy_error < 1e-4
 
 
+def test_counts_allow_the_fragments_to_vary_by_a_fraction_of_all_grains(tmp_path):
+    """counts c lets N_lar and the number of fragments vary by floor(c N) over the window,
+    as the analysis of the dumps measures it. With the contacts and dissipation left loose
+    (tolerance 0.9) the counts decide: a disruptive 2 x 32 collision whose small fragments
+    keep meeting stops earlier at c = 0.15 (9 grains) than with the counts unchanged."""
+    stops, ranges = {}, {}
+    for c in (0.0, 0.15):
+        d = write_scene(tmp_path / f"c{c}", v=80.0, seed=1)
+        rule = SettleRule(check_tc=20, window=5, tolerance=0.9, counts=c, cap_tc=6000)
+        with Session(d, d, every=1, settle=rule, variables=dict(frames=1)) as s:
+            s.run_until_settled(progress=False)
+            assert s.stop_reason == "settled"
+        stop = int(settle_line(d / "log.lammps")["step"])
+        check = rule.check_steps(0.014)
+        window = [np.bincount(from_contacts(f.ids, f.pairs)) for f in frames(d)
+                  if f.step >= stop - rule.window * check]
+        assert len(window) == rule.window + 1
+        stops[c] = stop
+        ranges[c] = [np.ptp([w.max() for w in window]), np.ptp([len(w) for w in window])]
+    assert ranges[0.0] == [0, 0]
+    assert max(ranges[0.15]) <= int(0.15 * 64)                # floor(c N) = 9
+    assert stops[0.15] < stops[0.0]
+
+
 def test_outcome_records_why_and_how_well_the_run_ended(settled):
     d, *_ = settled
     out = analyse_run(d, plots=False)

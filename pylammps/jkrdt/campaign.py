@@ -7,7 +7,7 @@ A spec (JSON) names the grid and the scene:
      "material_overrides": {"tvis": 6e-12}, "radius": 1e-7, "model": "frictional",
      "v_col": [10, 20, 40], "b_off2": [0, 0.25, 0.5, 0.75], "seeds": [1],
      "dt": 0.014, "settle": {"check_tc": 50, "window": 5, "tolerance": 0.01,
-                             "cap_tc": 40000}}
+                             "counts": 1e-4, "cap_tc": 40000}}
 
 n_tar, n_pro, v_col and b_off2 are required; the other keys default to the values above
 (material_overrides {}, settle {} = the settle rule's defaults), and any Material field

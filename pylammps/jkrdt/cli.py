@@ -191,10 +191,10 @@ def time_step(value: str):
 
 
 def settle_rule(args) -> SettleRule:
-    """The settle rule of --check, --window, --settle-tol and --cap."""
+    """The settle rule of --check, --window, --settle-tol, --settle-counts and --cap."""
     try:
         return SettleRule(check_tc=args.check, window=args.window, tolerance=args.settle_tol,
-                          cap_tc=args.cap)
+                          counts=args.settle_counts, cap_tc=args.cap)
     except ValueError as err:
         raise SystemExit(f"jkrdt: {err}") from None
 
@@ -214,6 +214,10 @@ def add_settle_options(p) -> None:
     p.add_argument("--settle-tol", type=float, default=d.tolerance,
                    help="allowed relative change of the contact count and of the dissipated "
                         "energy over the window (default %(default)g)")
+    p.add_argument("--settle-counts", type=float, default=d.counts,
+                   help="allowed change of N_lar and of the number of fragments over the "
+                        "window, as a fraction of all grains (default %(default)g: unchanged "
+                        "below 10^4 grains)")
 
 
 def run(args) -> int:

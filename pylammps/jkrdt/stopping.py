@@ -5,7 +5,9 @@ The settle rule is ``fix jkr/dt/settle`` of the plugin (its line is in
 connected components of the bonded contacts); the collision has settled when,
 over the last ``window`` checks,
 
-* the largest fragment N_lar and the number of fragments have not changed,
+* the largest fragment N_lar and the number of fragments have each varied by at
+  most ``counts`` of all grains, rounded down (unchanged below 1/counts grains;
+  at 10^5 grains thousands of fragments still fly when the outcome is fixed),
 * the number of bonded contacts has varied by at most ``tolerance`` of its value,
 * the energy dissipated over the window is at most ``tolerance`` of all the
   energy dissipated so far (restructuring has stopped).
@@ -56,6 +58,7 @@ class SettleRule:
     check_tc: float = 50.0        # simulated time between checks, t_c
     window: int = 5               # checks that must agree
     tolerance: float = 0.01       # relative change of contacts and dissipation allowed
+    counts: float = 1e-4          # change of N_lar and of the fragment count, of all grains
     cap_tc: float = 40000.0       # simulated time at which an unsettled run stops, t_c
     depart: str = "yes"           # fragments that have left for good stop: yes, no, shadow
 
@@ -67,6 +70,9 @@ class SettleRule:
                              f"(got {self.window})")
         if not 0 <= self.tolerance < 1:
             raise ValueError(f"settle tolerance is a fraction in [0, 1) (got {self.tolerance})")
+        if not 0 <= self.counts < 1:
+            raise ValueError(f"settle counts is a fraction of all grains in [0, 1) "
+                             f"(got {self.counts}; 0: N_lar and fragments unchanged)")
         if self.depart not in DEPART:
             raise ValueError(f"settle depart must be one of {DEPART} (got {self.depart!r})")
         if not self.cap_tc > self.check_tc:
@@ -85,7 +91,8 @@ class SettleRule:
     def deck_variables(self, dt_over_tc: float) -> dict:
         """Variables of ``inputs/collision.lmp`` that switch the rule on."""
         return dict(settle="yes", every=self.check_steps(dt_over_tc), window=self.window,
-                    settle_tol=self.tolerance, steps=self.cap_steps(dt_over_tc),
+                    settle_tol=self.tolerance, settle_counts=self.counts,
+                    steps=self.cap_steps(dt_over_tc),
                     depart=self.depart)
 
 
