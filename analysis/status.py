@@ -4,8 +4,14 @@
   jkr/dt/settle writes when it ends a run (``jkrdt.stopping`` has the rule);
 * ``steps``: a run of a fixed number of steps (no settle rule) that completed;
 * ``error``: the log holds a LAMMPS ERROR line;
-* ``cut off``: the log ends inside a run (the process was killed), or the dumps end
-  before the run did.
+* ``cut off``: the log ends inside a run (the process was killed), or between two of its
+  run commands (a campaign or session that runs in chunks, killed between two), or the
+  dumps end before the run did.
+
+A run has ended by its own rule only when its log holds the deck's last line,
+``jkr/dt: run finished step S`` (``FINISH_LINE``), which the deck's end part (``label
+finish``, also what a Session runs when it closes) prints after writing the last frames
+and final.restart.
 
 A run that failed or was cut off is not a collision outcome: ``problem`` says why,
 and the analysis refuses it unless asked to analyse what is there.
@@ -19,6 +25,7 @@ from pathlib import Path
 from jkrdt.scene import LOG
 
 SETTLE_LINE = "jkr/dt/settle: stop_reason"
+FINISH_LINE = "jkr/dt: run finished step"
 
 
 @dataclasses.dataclass
@@ -58,6 +65,11 @@ def run_status(run, last_dump_step: int | None = None) -> RunStatus:
     if header and (not loops or loops[-1] < header[-1]):
         return RunStatus("cut off", last_step, f"{log} ends inside a run at step {last_step}: "
                          "the run was cut off")
+    if not any(line.startswith(FINISH_LINE) for line in lines):
+        return RunStatus("cut off", last_step, f"{log} stops at step {last_step} without its "
+                         f"last line ('{FINISH_LINE} ...'): the run was cut off between two "
+                         "of its run commands; run it again (jkrdt run), let jkrdt campaign "
+                         "resume it, or analyse what is there with --partial")
     if settle:
         reason, stop = settle[-1]["stop_reason"], int(settle[-1]["step"])
         # a later run without the rule (e.g. 'run 1000' after settling) ends elsewhere

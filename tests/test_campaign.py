@@ -1,6 +1,7 @@
 """A small campaign end to end: v_col x B_off^2 runs, resumed without redoing finished
 runs, summarised with eq. (1) of the 3D BPCA paper; under mpirun -np 2 two runs at once
-with the serial campaign's results; a killed campaign resumed from its restart files; two
+with the serial campaign's results; a killed campaign's run refused by the analysis and
+resumed from its restart files; two
 campaigns on one directory sharing its runs."""
 
 import json
@@ -36,7 +37,7 @@ def campaign(tmp_path_factory):
 
 def test_every_run_is_analysed(campaign):
     _, runs, first = campaign
-    assert first == dict(runs=6, skipped=0, ran=6)
+    assert first == dict(runs=6, skipped=0, ran=6, failed=[])
     outcomes = sorted(runs.rglob("outcome.json"))
     assert len(outcomes) == 6
     for path in outcomes:
@@ -57,7 +58,7 @@ def test_resume_skips_finished_runs(campaign):
     kept = json.loads(redo.read_text())
     redo.unlink()
     again = run_campaign(spec, runs, progress=False)
-    assert again == dict(runs=6, skipped=5, ran=1)
+    assert again == dict(runs=6, skipped=5, ran=1, failed=[])
     assert all(p.stat().st_mtime_ns == t for p, t in before.items())
     # the redone run is the same simulation
     assert json.loads(redo.read_text())["n_largest"] == kept["n_largest"]
@@ -165,7 +166,23 @@ def test_a_killed_campaign_resumes_from_its_restart_file(tmp_path):
     os.killpg(proc.pid, signal.SIGKILL)
     proc.wait()
     assert not (run / "outcome.json").exists(), "the run ended before it could be killed"
-    assert run_campaign(spec, cut, progress=False) == dict(runs=1, skipped=0, ran=1)
+    # cut off, wherever the kill fell: inside a chunk, or (the log cut back to its last
+    # whole chunk, as when the kill falls between two) after a whole run command
+    log = run / "log.lammps"
+    for between in (False, True):
+        if between:
+            lines = log.read_text().splitlines(keepends=True)
+            last = max(k for k, line in enumerate(lines) if line.startswith("Loop time of"))
+            kept = log.read_text()
+            log.write_text("".join(lines[:last + 1]))
+        analysed = subprocess.run([str(BIN / "jkrdt"), "analyse", str(run), "--no-plots"],
+                                  capture_output=True, text=True)
+        assert analysed.returncode != 0 and "Traceback" not in analysed.stderr
+        assert "the run was cut off" in analysed.stderr, analysed.stderr
+        assert not (run / "outcome.json").exists()
+    assert "between two of its run commands" in analysed.stderr
+    log.write_text(kept)
+    assert run_campaign(spec, cut, progress=False) == dict(runs=1, skipped=0, ran=1, failed=[])
     log = (run / "log.lammps").read_text()
     assert log.count("Reading restart file") == 1     # continued, not started again
     whole = json.loads(next((tmp_path / "whole").rglob("outcome.json")).read_text())
@@ -200,13 +217,43 @@ def test_spec_errors_name_the_fix(tmp_path):
     assert not (tmp_path / "runs").exists()
 
 
+def jkrdt_campaign(spec, where, *options):
+    return subprocess.run([str(BIN / "jkrdt"), "campaign", str(spec), str(where), "--quiet",
+                           *options], capture_output=True, text=True, timeout=600)
+
+
+def test_a_campaign_directory_belongs_to_one_spec(tmp_path):
+    one = dict(SPEC, v_col=[20.0], b_off2=[0.0])
+    spec = tmp_path / "spec.json"
+    spec.write_text(json.dumps(one))
+    assert jkrdt_campaign(spec, tmp_path / "runs").returncode == 0
+    record = json.loads((tmp_path / "runs" / "campaign.json").read_text())
+    assert record["spec"]["model"] == "frictional" and record["versions"] == ["0.1.0"]
+    assert record["spec"]["settle"]["window"] == 5              # the rule written out in full
+    spec.write_text(json.dumps(dict(one, model="frictionless")))
+    refused = jkrdt_campaign(spec, tmp_path / "runs")
+    assert refused.returncode == 2 and refused.stderr.count("\n") == 1, refused.stderr
+    assert "\"model\" was 'frictional', now 'frictionless'" in refused.stderr
+    assert "--fresh" in refused.stderr
+    assert jkrdt_campaign(spec, tmp_path / "runs", "--fresh").returncode == 0
+    out = json.loads(next((tmp_path / "runs").rglob("outcome.json")).read_text())
+    assert out["model"] == "frictionless" and out["stop_reason"] == "settled"
+
+
 def test_failed_run_is_recorded_and_left_out_of_the_summary(tmp_path):
     spec = tmp_path / "spec.json"
-    spec.write_text(json.dumps(dict(SPEC, v_col=[20.0], b_off2=[0.0], dt=0.6)))
+    # T_vis 10^6 times the paper's: the damping throws a contact's grains apart faster
+    # than the skin holds them in a step, and LAMMPS stops
+    spec.write_text(json.dumps(dict(SPEC, v_col=[20.0], b_off2=[0.0],
+                                    material_overrides={"tvis": 1e-6})))
     assert run_campaign(spec, tmp_path / "runs", progress=False)["ran"] == 1
     out = json.loads(next((tmp_path / "runs").rglob("outcome.json")).read_text())
-    assert out["stop_reason"] == "error" and "above 0.4 t_c" in out["problem"]
-    # finished as far as resuming goes: not tried again
-    assert run_campaign(spec, tmp_path / "runs", progress=False)["skipped"] == 1
+    assert out["stop_reason"] == "error" and "raise the skin above" in out["problem"]
+    # finished as far as resuming goes: not tried again, and the exit status says so
+    again = jkrdt_campaign(spec, tmp_path / "runs")
+    assert again.returncode == 1 and "0 run(s) done, 1 already finished" in again.stdout
+    assert "1 of the 1 runs failed" in again.stderr and "--retry-failed" in again.stderr
+    retried = run_campaign(spec, tmp_path / "runs", progress=False, retry_failed=True)
+    assert retried["ran"] == 1 and len(retried["failed"]) == 1     # tried again, failed again
     with pytest.raises(ValueError, match=r"none of its 1 runs is complete \(\['error'\]\)"):
         summarise(tmp_path / "runs", plot=False)

@@ -36,6 +36,11 @@ def one_line_error(args, match, cwd=None):
     (["run", ".", "--steps", "0"], "--steps must be >= 1"),
     (["setup", "--dt", "fast"], "--dt takes a time step in units of t_c or 'auto'"),
     (["demo", "--window", "0"], "settle window must be a whole number of checks >= 1"),
+    (["setup", "--v", "-2e1"], "--v is the collision speed and must be > 0"),
+    (["setup", "--radius", "-1e-7"], "the grain radius must be > 0 m (got -1e-07)"),
+    (["setup", "--dt", "5"], "--dt must be at most 0.4 t_c"),
+    (["setup", "--tolerance", "1e-3"], "--tolerance goes with --dt auto"),
+    (["build", "--n", "1073741824"], "1073741824 grains need about 4e+03 GiB to build"),
     (["demo", "--settle-counts", "1"], "settle counts is a fraction of all grains in [0, 1)"),
 ])
 def test_option_errors(tmp_path, args, match):
@@ -71,6 +76,7 @@ SPEC = dict(n_tar=8, n_pro=8, v_col=[10], b_off2=[0.0])
     (dict(seeds="1"), '"seeds" must be a non-empty list of whole numbers'),
     (dict(material="granite"), "unknown material 'granite'"),
     (dict(material_overrides={"hardness": 3}), '"material"/"material_overrides"'),
+    (dict(dt=5), '"dt" must be a time step in (0, 0.4] in units of t_c'),
 ])
 def test_campaign_spec_errors_name_the_key(tmp_path, change, match):
     spec = tmp_path / "spec.json"

@@ -86,6 +86,25 @@ def test_jkrdt_run_runs_the_scenes_own_deck(tmp_path):
     assert f"pair_coeff      * * {pair_coeff(ICE, 'frictionless')}" in log
 
 
+def test_the_skin_follows_the_scene_so_10_micron_grains_run_as_set_up(tmp_path):
+    """A pair at 2 v_col closes a quarter of the skin per step: 8 v_col dt for 10 micron
+    ice at 20 m/s (0.13 micron), where 10 nm (the skin of 0.1 micron grains) stops the run."""
+    ran = {}
+    for name, skin in (("given", ["--skin", "1e-8"]), ("chosen", [])):
+        d = tmp_path / name
+        subprocess.run([str(BIN / "jkrdt"), "setup", "--n-tar", "8", "--n-pro", "8", "--v",
+                        "20", "--radius", "1e-5", "--out", str(d), *skin], check=True,
+                       capture_output=True, timeout=120)
+        ran[name] = subprocess.run([str(BIN / "jkrdt"), "run", str(d), "--steps", "3000"],
+                                   capture_output=True, text=True, timeout=300)
+    meta = scene_module.read_metadata(tmp_path / "chosen")
+    t_c = scene_module.from_metadata(meta).scales.t_c
+    assert meta["skin"] == pytest.approx(8 * 20.0 * 0.014 * t_c, rel=1e-12)
+    assert meta["skin"] == pytest.approx(1.32e-7, rel=0.01)
+    assert ran["chosen"].returncode == 0, ran["chosen"].stderr
+    assert ran["given"].returncode != 0 and "raise the skin above" in ran["given"].stderr
+
+
 CORE = ["aggregates", "collision", "datafile", "ledger", "materials", "plugin", "scene",
         "session", "stopping", "timestep"]
 

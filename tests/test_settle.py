@@ -32,8 +32,8 @@ S = scales(ICE, R)
 RULE = SettleRule(check_tc=20, window=5, tolerance=0.01, cap_tc=6000)
 
 
-def write_scene(directory, v=10.0, seed=3, n=32):
-    scene = scene_module.Scene(ICE, n, n, v_col=v, seed=seed, kind="bcca", dim=2)
+def write_scene(directory, v=10.0, seed=3, n=32, skin=None):
+    scene = scene_module.Scene(ICE, n, n, v_col=v, seed=seed, kind="bcca", dim=2, skin=skin)
     return scene_module.write(directory, scene)
 
 
@@ -124,16 +124,18 @@ def test_cap_ends_an_unsettled_run_and_is_flagged_in_the_campaign(settled, tmp_p
 
 
 def test_failed_run_is_refused_by_the_analysis_with_the_cause(tmp_path):
-    d = write_scene(tmp_path / "failed")
-    done = subprocess.run([BIN + "jkrdt", "run", str(d), "--dt", "0.6"], capture_output=True,
+    # at 2000 m/s a pair closes 7.7 nm per step at the papers' dt: more than half of a
+    # 1 nm skin (the user's; the scene's own would be 61 nm)
+    d = write_scene(tmp_path / "failed", v=2000.0, skin=1e-9)
+    done = subprocess.run([BIN + "jkrdt", "run", str(d)], capture_output=True,
                           text=True, timeout=120)
     assert done.returncode != 0
-    assert "above 0.4 t_c velocity Verlet cannot hold a contact" in done.stderr
+    assert "more than half the neighbor skin" in done.stderr
     refused = subprocess.run([BIN + "jkrdt", "analyse", str(d), "--no-plots"],
                              capture_output=True, text=True, timeout=120)
     assert refused.returncode != 0
     assert refused.stderr.startswith("jkrdt: ") and "Traceback" not in refused.stderr
-    assert "the run failed: ERROR: pair jkr/dt: timestep" in refused.stderr
+    assert "the run failed: ERROR on proc 0: pair jkr/dt: atoms" in refused.stderr
     assert "--partial" in refused.stderr
 
 

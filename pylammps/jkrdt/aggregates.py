@@ -323,3 +323,19 @@ def fractal_fit(n: np.ndarray, rg_over_r: np.ndarray) -> tuple[float, float]:
 
 #: the aggregate builders by the name a scene gives them (``kind``)
 BUILDERS = {"bpca": bpca, "bcca": bcca}
+
+#: peak memory of building and setting up grains, per grain: jkrdt setup of 2 x 50000 BPCA
+#: grains peaked at 360 MB resident (README, "At the paper's size"), rounded up
+BYTES_PER_GRAIN = 4000
+
+
+def check_fits(n: int) -> None:
+    """Refuse ``n`` grains when building them would need more memory than the machine has."""
+    import os
+
+    need = n * BYTES_PER_GRAIN
+    have = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    if need > have:
+        raise ValueError(f"{n} grains need about {need / 2**30:.3g} GiB to build, and this "
+                         f"machine has {have / 2**30:.3g} GiB: choose fewer grains (at most "
+                         f"about {have // BYTES_PER_GRAIN})")

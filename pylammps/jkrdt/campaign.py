@@ -16,7 +16,8 @@ can be overridden in material_overrides.
 Each run ends when its collision has settled (``jkrdt.stopping``; "settle" may be
 left out for the defaults, or given in part), or, with ``"settle": false``, after
 ``"steps"`` steps, dumped every ``"every"`` steps. A run that fails is recorded with
-``"stop_reason": "error"`` in its outcome.json and is not tried again.
+``"stop_reason": "error"`` in its outcome.json and is not tried again unless asked
+(``retry_failed``).
 
 Each run goes to ``CAMPAIGN/v<v_col>/b2_<B_off^2>/seed<seed>`` as a scene directory
 (``jkrdt.scene``). Target and projectile are built once per seed and shared by all
@@ -28,6 +29,12 @@ when it is free. A run is claimed by a lock on ``RUN/.claim`` held while it goes
 the system releases when its holder dies: two campaigns on one directory never run the
 same collision, and a killed campaign's runs are free again.
 
+A campaign directory belongs to one spec: ``CAMPAIGN/campaign.json`` records the spec its
+runs were made with (defaults filled in, the settle rule in full) and the versions of
+jkr/dt that ran them. A campaign started on it with another spec is refused with the
+difference named, unless ``fresh`` (``--fresh``) deletes its runs first. A failed run
+stays failed until ``retry_failed`` (``--retry-failed``) runs it again from the start.
+
 A run is finished when its ``outcome.json`` exists; that file is written last,
 atomically, and is never replaced. A run that was cut off (no outcome.json, but a
 restart file) resumes from its newer whole restart file: its dumps and log are cut back
@@ -37,21 +44,25 @@ file, so the run ends as the uninterrupted one would have.
 
 from __future__ import annotations
 
+import dataclasses
 import fcntl
 import gzip
 import json
 import os
+import shutil
 import socket
 import time
 from pathlib import Path
 
 import numpy as np
 
+from . import __version__
 from . import scene as scene_module
 from .aggregates import BUILDERS
 from .materials import material
 from .scene import Scene
 from .stopping import SettleRule
+from .timestep import DT_STABLE
 DEFAULTS = dict(kind="bpca", dim=3, material="ice", material_overrides={}, radius=1.0e-7,
                 model="frictional", seeds=[1], dt=0.014, settle={}, steps=None, every=None)
 REQUIRED = ["n_tar", "n_pro", "v_col", "b_off2"]
@@ -80,7 +91,8 @@ CHECKS = {
     "radius": (lambda x: _number(x) and x > 0, "a grain radius > 0 in m"),
     "model": (lambda x: x in ("frictional", "frictionless"), "'frictional' or 'frictionless'"),
     "material_overrides": (lambda x: isinstance(x, dict), "an object of Material fields"),
-    "dt": (lambda x: _number(x) and x > 0, "a time step > 0 in units of t_c"),
+    "dt": (lambda x: _number(x) and 0 < x <= DT_STABLE,
+           f"a time step in (0, {DT_STABLE}] in units of t_c"),
     "steps": (lambda x: x is None or (_whole(x) and x >= 1), "a whole number of steps >= 1"),
     "every": (lambda x: x is None or (_whole(x) and x >= 1), "a whole number of steps >= 1"),
     "settle": (lambda x: isinstance(x, (bool, dict)), "true, false or an object of SettleRule "
@@ -136,6 +148,66 @@ def read_spec(path) -> dict:
         except ValueError as err:
             raise ValueError(f"{path}: {err}") from None
     return spec
+
+
+#: in the campaign directory: the spec its runs were made with and the versions that ran them
+SPEC_RECORD = "campaign.json"
+
+
+def spec_record(spec: dict) -> dict:
+    """What determines a campaign's runs, as JSON: the spec with its defaults filled in
+    and the settle rule in full (so that {} and the defaults written out are one spec)."""
+    record = dict(spec)
+    record["settle"] = (dataclasses.asdict(spec["settle"]) if spec["settle"] is not None
+                        else False)
+    return json.loads(json.dumps(record))
+
+
+def own(campaign: Path, spec: dict, fresh: bool = False) -> None:
+    """Make ``campaign`` the directory of ``spec``: record it there, or raise naming how the
+    spec it holds differs; ``fresh`` deletes the runs it holds first."""
+    from jkrdt.analysis.tables import write_json
+
+    path = campaign / SPEC_RECORD
+    want = spec_record(spec)
+    versions = [__version__]
+    if path.exists() and fresh:
+        for run in campaign.glob("v*"):
+            shutil.rmtree(run)
+        path.unlink()
+    elif path.exists():
+        had = json.loads(path.read_text())
+        differ = [k for k in sorted(set(had["spec"]) | set(want))
+                  if had["spec"].get(k) != want.get(k)]
+        if differ:
+            said = "; ".join(f'"{k}" was {had["spec"].get(k)!r}, now {want.get(k)!r}'
+                             for k in differ[:3])
+            raise ValueError(f"{campaign} holds the runs of another spec ({said}): give "
+                             "another directory, or --fresh to delete its runs and start "
+                             "afresh")
+        versions = sorted(set(had.get("versions", [])) | {__version__})
+    elif any(campaign.glob("v*/b2_*/seed*/outcome.json")) and not fresh:
+        raise ValueError(f"{campaign} holds runs but no {SPEC_RECORD}, so their spec is "
+                         "unknown: give another directory, or --fresh to delete its runs and "
+                         "start afresh")
+    elif fresh:
+        for run in campaign.glob("v*"):
+            shutil.rmtree(run)
+    campaign.mkdir(parents=True, exist_ok=True)
+    write_json(path, dict(spec=want, versions=versions))
+
+
+def retry(todo) -> int:
+    """Clear the runs of ``todo`` that failed, so that they run again from the start;
+    returns how many."""
+    cleared = 0
+    for *_, directory in todo:
+        outcome = directory / "outcome.json"
+        if outcome.exists() and json.loads(outcome.read_text()).get("stop_reason") == "error":
+            for name in scene_module.SCENE_FILES:
+                (directory / name).unlink(missing_ok=True)
+            cleared += 1
+    return cleared
 
 
 def record_failure(directory: Path, seed, error: str) -> None:
@@ -257,6 +329,14 @@ def cut_log(path: Path, step: int) -> None:
     path.write_text("".join(lines[:last]))
 
 
+def cut_back(directory: Path, step: int) -> None:
+    """A cut-off run's record cut back to ``step`` (its restart file's), to be appended to."""
+    for name in (scene_module.ATOMS, scene_module.CONTACTS):
+        cut_dump(directory / name, step)
+    cut_table(directory / scene_module.CHECKS, step)
+    cut_log(directory / scene_module.LOG, step)
+
+
 def prepare(directory: Path, scene: Scene, aggregates: dict):
     """Make ``directory`` ready to run (on the group's leader): "ended" if its run ended
     and only its analysis is missing; (restart file, step) to resume from, the outputs
@@ -270,10 +350,7 @@ def prepare(directory: Path, scene: Scene, aggregates: dict):
             return "ended"
     point = resume_point(directory)
     if point is not None:
-        for name in (scene_module.ATOMS, scene_module.CONTACTS):
-            cut_dump(directory / name, point[1])
-        cut_table(directory / scene_module.CHECKS, point[1])
-        cut_log(directory / scene_module.LOG, point[1])
+        cut_back(directory, point[1])
         return point
     for name in scene_module.SCENE_FILES:
         (directory / name).unlink(missing_ok=True)
@@ -319,13 +396,14 @@ def finish(directory: Path, seed, failed: str | None) -> str:
         except ValueError as err:        # the run's outputs do not add up: recorded
             failed = f"analysis: {err}"
     record_failure(directory, seed, failed)
-    return f"FAILED: {failed}"
+    return f"FAILED: {failed} (jkrdt campaign ... --retry-failed runs it again)"
 
 
 def run_campaign(spec_path, campaign, progress: bool = True, ranks_per_run: int = 1,
-                 comm=None) -> dict:
+                 comm=None, fresh: bool = False, retry_failed: bool = False) -> dict:
     """Run every unfinished run of the campaign (see the module text); returns the number
-    of runs, those finished before it started ("skipped") and those it ran ("ran").
+    of runs, those finished before it started ("skipped"), those it ran ("ran") and the
+    runs that failed ("failed": none when every run of the grid is complete).
     Under MPI the ranks of ``comm`` (default COMM_WORLD) run in groups of
     ``ranks_per_run``; every rank returns the same counts."""
     from mpi4py import MPI
@@ -340,6 +418,17 @@ def run_campaign(spec_path, campaign, progress: bool = True, ranks_per_run: int 
     leader = group.rank == 0
     campaign = Path(campaign)
     todo = plan(spec, campaign)
+    refused = None
+    if world.rank == 0:
+        try:
+            own(campaign, spec, fresh)
+            if retry_failed:
+                retry(todo)
+        except ValueError as err:
+            refused = str(err)
+    refused = world.bcast(refused)
+    if refused is not None:
+        raise ValueError(refused)
     skipped = sum((d / "outcome.json").exists() for *_, d in todo)
     world.Barrier()              # every rank has counted before any run finishes
     aggregates, ran = {}, 0
@@ -366,4 +455,6 @@ def run_campaign(spec_path, campaign, progress: bool = True, ranks_per_run: int 
         group.Barrier()
     group.Free()
     ran = world.allreduce(ran if leader else 0)
-    return dict(runs=len(todo), skipped=skipped, ran=ran)
+    failed = [str(d) for *_, d in todo if (d / "outcome.json").exists()
+              and json.loads((d / "outcome.json").read_text()).get("stop_reason") == "error"]
+    return dict(runs=len(todo), skipped=skipped, ran=ran, failed=failed)

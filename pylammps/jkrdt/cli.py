@@ -15,6 +15,9 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
+import os
+import re
+import signal
 import subprocess
 import sys
 import time
@@ -25,7 +28,7 @@ import numpy as np
 from . import campaign as campaign_module
 from . import ledger, timestep
 from . import scene as scene_module
-from .aggregates import BUILDERS, bonds, gyration_radius
+from .aggregates import BUILDERS, bonds, check_fits, gyration_radius
 from .datafile import write_sphere_data
 from .materials import PRESETS, material, scales
 from .scene import Scene
@@ -33,25 +36,61 @@ from .stopping import DEFAULT_RULE, ENERGY_WARN, STOP_WORDS, SettleRule
 
 
 def run_lammps(deck: Path, out: Path, variables: dict, nproc: int = 1) -> None:
+    """Run ``deck`` in ``out``; a continued run (``append`` yes) appends to the log."""
     lmp = Path(sys.executable).parent / "lmp"
-    cmd = [str(lmp), "-in", str(deck), "-log", str(out / scene_module.LOG), "-screen", "none"]
+    log = "none" if variables.get("append") == "yes" else str(out / scene_module.LOG)
+    cmd = [str(lmp), "-in", str(deck), "-log", log, "-screen", "none"]
     for k, v in variables.items():
         cmd += ["-var", k, str(v)]
     if nproc > 1:
         cmd = [str(Path(sys.executable).parent / "mpirun"), "-np", str(nproc)] + cmd
-    done = subprocess.run(cmd, cwd=out)
-    if done.returncode != 0:
+    returncode = run_stoppable(cmd, out)
+    if returncode != 0:
         log_path = out / scene_module.LOG
         log = log_path.read_text().splitlines() if log_path.exists() else []
         errors = [line.strip() for line in log if "ERROR" in line] or [
-            f"exit status {done.returncode}"]
+            f"exit status {returncode}"]
         raise SystemExit(f"jkrdt: LAMMPS stopped: {errors[-1]} (full log: {log_path})")
+
+
+#: the signals that stop jkrdt run, and its LAMMPS with it
+STOPPING = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
+def run_stoppable(cmd: list[str], cwd: Path) -> int:
+    """Run ``cmd`` (LAMMPS, or mpirun and its ranks) in a process group of its own and wait
+    for it; SIGINT, SIGTERM or SIGHUP to this process stops the whole group with it (TERM,
+    then KILL after 5 s), so that no LAMMPS goes on writing a run nobody waits for."""
+    child = subprocess.Popen(cmd, cwd=cwd, start_new_session=True)
+
+    def stop(signum, _frame):
+        for how in (signal.SIGTERM, signal.SIGKILL):
+            try:
+                os.killpg(child.pid, how)
+                child.wait(timeout=5)
+                break
+            except ProcessLookupError:
+                break
+            except subprocess.TimeoutExpired:
+                continue
+        raise SystemExit(f"jkrdt: stopped by {signal.Signals(signum).name}, and LAMMPS with "
+                         f"it: the run in {cwd} is cut off (jkrdt run starts it again)")
+
+    before = {s: signal.signal(s, stop) for s in STOPPING}
+    try:
+        return child.wait()
+    finally:
+        for s, handler in before.items():
+            signal.signal(s, handler)
 
 
 def output_interval(steps: int) -> int:
     """About steps/20, dividing steps, so that the last dump is the end of the run."""
     return next(d for d in range(max(1, steps // 20), 0, -1) if steps % d == 0)
 
+
+#: what --dt auto aims at without --tolerance
+AUTO_TOLERANCE = 1e-4
 
 MATERIAL_FIELDS = ("gamma", "E", "nu", "G", "density", "xi_crit", "tvis")
 
@@ -79,6 +118,7 @@ def add_material_options(p) -> None:
 
 
 def build(args) -> int:
+    check_fits(args.n)
     mat = chosen_material(args)
     s = scales(mat, args.radius)
     t0 = time.time()
@@ -117,6 +157,11 @@ def write_scene(scene: Scene, out, tolerance: float | None = None, force: bool =
         except ValueError as err:
             raise SystemExit(f"jkrdt: {err}") from None
         scene = dataclasses.replace(scene, dt_over_tc=dt, dt_reason=reason)
+        expected = timestep.predicted_error(dt, scene.v_col / scene.scales.v0)
+        if expected > 1.001 * tolerance:
+            print(f"jkrdt: WARNING: --dt auto cannot reach --tolerance {tolerance:g} at "
+                  f"{scene.v_col:g} m/s: dt is held at {dt:g} t_c, where the fit expects max "
+                  f"|dE| / E_imp = {expected:.2g}", file=sys.stderr)
     t0 = time.time()
     placed = scene.collide()
     built = time.time() - t0
@@ -129,10 +174,12 @@ def write_scene(scene: Scene, out, tolerance: float | None = None, force: bool =
 
 
 def run_scene(out: Path, dt: float | None, steps: int | None, nproc: int,
-              rule: SettleRule = DEFAULT_RULE) -> None:
+              rule: SettleRule = DEFAULT_RULE, force: bool = False) -> None:
     """Run the scene in ``out`` with its own deck, in its own directory: until it
     settles by ``rule`` (the cap included), or ``steps`` steps when given; ``dt`` (t_c)
-    overrides the scene's time step."""
+    overrides the scene's time step. A run that was cut off continues from its newer
+    restart file, adding to its record; a finished run is refused unless ``force``, which
+    runs it again from the start."""
     from jkrdt.analysis.status import run_status
     from jkrdt.analysis.thermo import read_thermo
 
@@ -144,8 +191,24 @@ def run_scene(out: Path, dt: float | None, steps: int | None, nproc: int,
         variables.update(rule.deck_variables(ratio))
     else:
         variables.update(settle="no", steps=steps, every=output_interval(steps))
-    for stale in scene_module.RUN_OUTPUTS:
-        (out / stale).unlink(missing_ok=True)
+    before = run_status(out) if (out / scene_module.LOG).exists() else None
+    resume = None
+    if before is not None and before.problem is None and not force:
+        raise SystemExit(f"jkrdt: {out} holds a finished run ({STOP_WORDS[before.stop_reason]} "
+                         f"at step {before.stop_step}); --force runs it again from the start, "
+                         "replacing its record")
+    if before is not None and before.stop_reason == "cut off" and not force:
+        resume = campaign_module.resume_point(out)
+    if resume is not None:
+        restart, start = resume
+        campaign_module.cut_back(out, start)
+        variables.update(read="read_restart", file=restart.name, append="yes",
+                         steps=int(variables["steps"]) - start)
+        print(f"continuing the run that was cut off, from {restart.name} at step {start}")
+    else:
+        for stale in scene_module.SCENE_FILES:
+            if stale not in (scene_module.DATA, scene_module.META, scene_module.DECK):
+                (out / stale).unlink(missing_ok=True)
     t0 = time.time()
     run_lammps(deck, out, variables, nproc=nproc)
     status = run_status(out)
@@ -165,7 +228,7 @@ def chosen_scene(args) -> Scene:
         return Scene(material=chosen_material(args), n_tar=args.n_tar, n_pro=args.n_pro,
                      v_col=args.v, b_off=args.b_off, seed=args.seed, kind=args.kind,
                      dim=args.dim, radius=args.radius, model=args.model,
-                     dt_over_tc=None if args.dt in (None, "auto") else args.dt,
+                     dt_over_tc=None if args.dt in (None, "auto") else args.dt, skin=args.skin,
                      dt_reason=None if args.dt in (None, "auto") else
                      f"dt = {args.dt:g} t_c given to jkrdt setup")
     except ValueError as err:
@@ -177,8 +240,12 @@ def setup(args) -> int:
         raise SystemExit(f"jkrdt: --v is the collision speed and must be > 0 m/s (got {args.v})")
     if not 0 <= args.b_off <= 1:
         raise SystemExit(f"jkrdt: --b-off must lie in [0, 1] (got {args.b_off})")
+    if args.tolerance is not None and args.dt != "auto":
+        raise SystemExit("jkrdt: --tolerance goes with --dt auto (the energy error dt is "
+                         "chosen for); give --dt auto, or leave --tolerance out")
     write_scene(chosen_scene(args), args.out,
-                tolerance=args.tolerance if args.dt == "auto" else None, force=args.force)
+                tolerance=(args.tolerance if args.tolerance is not None else AUTO_TOLERANCE)
+                if args.dt == "auto" else None, force=args.force)
     return 0
 
 
@@ -226,7 +293,8 @@ def run(args) -> int:
                          "scene); jkrdt run takes a number of t_c or the scene's dt")
     if args.steps is not None and args.steps < 1:
         raise SystemExit(f"jkrdt: --steps must be >= 1 (got {args.steps})")
-    run_scene(Path(args.dir).resolve(), args.dt, args.steps, args.np, settle_rule(args))
+    run_scene(Path(args.dir).resolve(), args.dt, args.steps, args.np, settle_rule(args),
+              force=args.force)
     return 0
 
 
@@ -267,13 +335,19 @@ def campaign(args) -> int:
     from mpi4py import MPI
 
     done = run_campaign(args.spec, args.dir, progress=not args.quiet,
-                        ranks_per_run=args.ranks_per_run)
+                        ranks_per_run=args.ranks_per_run, fresh=args.fresh,
+                        retry_failed=args.retry_failed)
+    busy = done["runs"] - done["skipped"] - done["ran"]
     if MPI.COMM_WORLD.rank == 0:
-        busy = done["runs"] - done["skipped"] - done["ran"]
         print(f"{done['ran']} run(s) done, {done['skipped']} already finished"
               + (f", {busy} run by another campaign at the same time" if busy > 0 else "")
               + f", in {args.dir}")
-    return 0
+        if done["failed"]:
+            print(f"jkrdt: {len(done['failed'])} of the {done['runs']} runs failed (the first: "
+                  f"{done['failed'][0]}); --retry-failed runs them again", file=sys.stderr)
+    # the exit status says whether a run of the grid failed (runs another campaign on the
+    # same directory still holds are its to finish)
+    return 1 if done["failed"] else 0
 
 
 def summarise(args) -> int:
@@ -334,6 +408,20 @@ class ArgumentParser(argparse.ArgumentParser):
         self.exit(2, f"jkrdt: {message} (see '{self.prog} --help')\n")
 
 
+def negative_values_joined(argv: list[str]) -> list[str]:
+    """``--v -2e1`` as ``--v=-2e1``: argparse takes a word that starts with '-' and is not
+    a plain number (-2e1, -1e-7) for an option, and says only 'expected one argument'; so
+    such a value reaches the option's own check, which names the problem."""
+    out: list[str] = []
+    for word in argv:
+        if (out and out[-1].startswith("--") and "=" not in out[-1]
+                and re.fullmatch(r"-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?", word)):
+            out[-1] = f"{out[-1]}={word}"
+        else:
+            out.append(word)
+    return out
+
+
 def main(argv=None) -> int:
     parser = ArgumentParser(prog="jkrdt", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
@@ -363,8 +451,11 @@ def main(argv=None) -> int:
                          "--tolerance and the impact speed (default: 0.014, the papers')")
     st.add_argument("--force", action="store_true",
                     help="write into a non-empty --out, replacing an earlier scene and its run")
-    st.add_argument("--tolerance", type=float, default=1e-4,
-                    help="max |dE| / E_imp that --dt auto aims at (default %(default)g)")
+    st.add_argument("--tolerance", type=float, default=None,
+                    help=f"max |dE| / E_imp that --dt auto aims at (default {AUTO_TOLERANCE:g})")
+    st.add_argument("--skin", type=float, default=None,
+                    help="neighbor skin, m (default: 1e-8, or 8 v_col dt where grains move "
+                         "farther in a step: large grains, fast collisions)")
     st.add_argument("--out", default="runs/scene")
     bd = sub.add_parser("build", help="build one aggregate and write it as a data file")
     bd.add_argument("--kind", choices=list(BUILDERS), default="bpca")
@@ -380,6 +471,9 @@ def main(argv=None) -> int:
                     help="time step in units of t_c for this run (default: the scene's); the "
                          "model is the scene's, set by jkrdt setup --model")
     rn.add_argument("--np", type=int, default=1, help="MPI ranks")
+    rn.add_argument("--force", action="store_true",
+                    help="run a finished run again from the start, replacing its record (a "
+                         "run that was cut off continues without it)")
     an = sub.add_parser("analyse", help="outcome of a run directory: metrics per frame, "
                         "outcome.json, frames.csv, pictures")
     an.add_argument("dir")
@@ -398,6 +492,11 @@ def main(argv=None) -> int:
                     help="MPI ranks per collision under mpirun -np N: N / K collisions run "
                          "side by side (default %(default)d)")
     cp.add_argument("--quiet", action="store_true", help="no line per finished run")
+    cp.add_argument("--fresh", action="store_true",
+                    help="delete the runs the directory holds (of this or another spec) and "
+                         "start afresh")
+    cp.add_argument("--retry-failed", action="store_true",
+                    help="run the runs that failed again, from the start")
     sm = sub.add_parser("summarise", help="B_off-weighted statistics of a campaign: "
                         "runs.csv, summary.csv, summary.json, plots")
     sm.add_argument("dir")
@@ -406,7 +505,8 @@ def main(argv=None) -> int:
                     help="average in the runs that hit the settle cap (left out by default)")
     parser.add_argument("--debug", action="store_true",
                         help="show the Python traceback of an error instead of one line")
-    args = parser.parse_args(argv)
+    args = parser.parse_args(negative_values_joined(sys.argv[1:] if argv is None
+                                                    else [str(a) for a in argv]))
     command = {"demo": demo, "build": build, "setup": setup, "run": run, "analyse": analyse,
                "campaign": campaign, "summarise": summarise}[args.command]
     try:

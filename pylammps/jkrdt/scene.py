@@ -25,7 +25,8 @@ from pathlib import Path
 import numpy as np
 
 from . import collision
-from .aggregates import BUILDERS
+from . import timestep
+from .aggregates import BUILDERS, check_fits
 from .datafile import write_sphere_data
 from .materials import Material, from_dict, scales
 from .timestep import PAPER_DT
@@ -74,6 +75,15 @@ def pair_coeff(mat: Material, model: str = "frictional") -> str:
     return " ".join(words)
 
 
+#: the neighbor skin (m) of a scene whose grains are slow enough for it: ~10 delta_c of
+#: 0.1 micron ice. Faster steps get SKIN_STEPS times the step of a pair at 2 v_col
+SKIN_MIN = 1.0e-8
+#: the plugin stops a pair that closes more than half the skin in one step; a pair of the
+#: collision closes at most ~v_col per step (2 v_col for a grain thrown back), so 4 steps of
+#: 2 v_col keep it at a quarter of the skin
+SKIN_STEPS = 4.0
+
+
 @dataclasses.dataclass(frozen=True)
 class Scene:
     """What one collision is. ``dt_over_tc`` None means the papers' 0.014 t_c."""
@@ -90,6 +100,7 @@ class Scene:
     model: str = "frictional"
     dt_over_tc: float | None = None
     dt_reason: str | None = None
+    skin: float | None = None       # m; None: from the speed and dt (skin_for)
 
     def __post_init__(self):
         if not self.v_col > 0:
@@ -101,10 +112,15 @@ class Scene:
             raise ValueError(f"unknown aggregate kind {self.kind!r}: one of {sorted(BUILDERS)}")
         if self.dim not in (2, 3):
             raise ValueError(f"dimension must be 2 or 3 (got {self.dim})")
+        if self.skin is not None and not self.skin > 0:
+            raise ValueError(f"the neighbor skin must be > 0 m (got {self.skin:g})")
+        if not self.radius > 0:
+            raise ValueError(f"the grain radius must be > 0 m (got {self.radius:g})")
         if min(self.n_tar, self.n_pro) < 1:
             raise ValueError("each aggregate needs at least one grain")
-        if self.dt_over_tc is not None and not self.dt_over_tc > 0:
-            raise ValueError(f"dt must be > 0 (in units of t_c; got {self.dt_over_tc})")
+        check_fits(self.n_tar + self.n_pro)
+        if self.dt_over_tc is not None:
+            timestep.check(self.dt_over_tc)
         pair_coeff(self.material, self.model)          # the model fits the material
 
     @functools.cached_property
@@ -134,7 +150,14 @@ class Scene:
         """The deck's dt (s), dt_over_tc and dt_note for ``dt_over_tc`` (see time_step)."""
         ratio, why = self.time_step(dt_over_tc)
         return dict(dt=ratio * self.scales.t_c, dt_over_tc=ratio,
-                    dt_note=why.replace('"', "'"))
+                    dt_note=why.replace('"', "'"), skin=self.skin_for(ratio))
+
+    def skin_for(self, dt_over_tc: float) -> float:
+        """The neighbor skin (m): the scene's own, else SKIN_MIN or, for grains that move
+        farther in a step (large grains, fast collisions), SKIN_STEPS steps at 2 v_col."""
+        if self.skin is not None:
+            return self.skin
+        return max(SKIN_MIN, SKIN_STEPS * 2.0 * self.v_col * dt_over_tc * self.scales.t_c)
 
     def deck_variables(self) -> dict:
         """The variables of ``inputs/collision.lmp`` that make it run this scene."""
@@ -172,6 +195,7 @@ class Scene:
                     model=self.model)
         if self.dt_over_tc is not None:
             meta.update(dt_over_tc=self.dt_over_tc, dt_reason=self.dt_reason)
+        meta.update(skin=self.skin_for(self.time_step()[0]), skin_given=self.skin is not None)
         return meta
 
 
@@ -182,7 +206,8 @@ def from_metadata(meta: dict) -> Scene:
                  seed=meta.get("seed"), kind=meta.get("kind") or "bpca",
                  dim=meta["dimension"], radius=meta["radius"],
                  model=meta.get("model") or "frictional", dt_over_tc=meta.get("dt_over_tc"),
-                 dt_reason=meta.get("dt_reason"))
+                 dt_reason=meta.get("dt_reason"),
+                 skin=meta["skin"] if meta.get("skin_given") else None)
 
 
 def read_metadata(directory) -> dict:

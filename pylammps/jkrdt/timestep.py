@@ -21,6 +21,8 @@ from pathlib import Path
 #: the papers' time step (Wada et al. 2007, sec. 4): |dE| / E_imp below 1e-4
 PAPER_DT = 0.014
 DT_MIN, DT_MAX = 0.002, 0.1      # t_c; above DT_MAX the plugin warns
+#: the plugin refuses dt above this (pair_style jkr/dt dt_check; benchmarks/stability.py)
+DT_STABLE = 0.4
 FIT_FILE = Path(__file__).with_name("timestep_fit.json")
 
 
@@ -61,6 +63,14 @@ def parse(value: str) -> float | str:
         dt = float(value)
     except ValueError:
         raise ValueError(f"--dt takes a time step in units of t_c or 'auto' (got {value!r})")
+    return check(dt, "--dt ")
+
+
+def check(dt: float, name: str = "dt ") -> float:
+    """``dt`` (t_c) if the plugin runs it, else a ValueError naming the range."""
     if not dt > 0:
-        raise ValueError(f"--dt must be > 0 (in units of t_c; got {value})")
+        raise ValueError(f"{name}must be > 0 (in units of t_c; got {dt:g})")
+    if dt > DT_STABLE:
+        raise ValueError(f"{name}must be at most {DT_STABLE} t_c, where velocity Verlet still "
+                         f"holds a contact (got {dt:g}; the papers' is {PAPER_DT})")
     return dt

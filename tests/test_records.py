@@ -1,0 +1,84 @@
+"""Records you can trust: a command that is stopped stops its LAMMPS, and what it leaves
+is refused as an outcome until it is run again."""
+
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+BIN = Path(sys.executable).parent
+JKRDT = str(BIN / "jkrdt")
+
+
+def test_stopping_jkrdt_run_stops_its_lammps(tmp_path):
+    d = tmp_path / "scene"
+    subprocess.run([JKRDT, "setup", "--n-tar", "64", "--n-pro", "64", "--v", "20", "--out",
+                    str(d)], check=True, capture_output=True, timeout=300)
+    run = subprocess.Popen([JKRDT, "run", str(d), "--steps", "50000000"],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    log = d / "log.lammps"
+    deadline = time.time() + 120
+    while time.time() < deadline and not (log.exists() and "Step" in log.read_text()):
+        time.sleep(0.1)
+    time.sleep(1.0)                                  # well inside the run
+    run.send_signal(signal.SIGTERM)
+    _, err = run.communicate(timeout=20)
+    assert run.returncode == 2 and err.count("\n") == 1, err
+    assert "stopped by SIGTERM, and LAMMPS with it" in err
+    # no LAMMPS left writing: no process names the scene, and the log holds still
+    size = log.stat().st_size
+    time.sleep(2.0)
+    assert log.stat().st_size == size
+    left = subprocess.run(["pgrep", "-f", str(d)], capture_output=True, text=True)
+    assert left.stdout == "", left.stdout
+    analysed = subprocess.run([JKRDT, "analyse", str(d), "--no-plots"], capture_output=True,
+                              text=True, timeout=300)
+    assert analysed.returncode == 2 and "the run was cut off" in analysed.stderr
+    assert not (d / "outcome.json").exists()
+
+
+def test_a_run_cut_off_continues_as_the_uninterrupted_one_and_a_finished_one_is_kept(tmp_path):
+    """jkrdt run on a run that was cut off continues it from its newer restart file, adding
+    to its record, so that its analysis equals the uninterrupted run's (restarts are exact:
+    tests/test_lifecycle.py); on a finished run it refuses without --force."""
+    import json
+    import shutil
+
+    straight, cut = tmp_path / "straight", tmp_path / "cut"
+    subprocess.run([JKRDT, "setup", "--n-tar", "64", "--n-pro", "64", "--v", "20", "--out",
+                    str(straight)], check=True, capture_output=True, timeout=300)
+    shutil.copytree(straight, cut)
+    rule = ["--check", "10"]
+    subprocess.run([JKRDT, "run", str(straight), *rule], check=True, capture_output=True,
+                   timeout=600)
+    run = subprocess.Popen([JKRDT, "run", str(cut), *rule], stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, text=True)
+    deadline = time.time() + 300
+    while not (cut / "restart.b").exists() and time.time() < deadline:
+        time.sleep(0.02)
+    time.sleep(0.3)                                  # a few more checks
+    run.send_signal(signal.SIGINT)
+    run.communicate(timeout=20)
+    assert run.returncode == 2 and not (cut / "final.restart").exists(), "ended before the cut"
+    again = subprocess.run([JKRDT, "run", str(cut), *rule], capture_output=True, text=True,
+                           timeout=600)
+    assert again.returncode == 0, again.stderr
+    assert "continuing the run that was cut off, from restart." in again.stdout
+    outcomes = []
+    for d in (straight, cut):
+        subprocess.run([JKRDT, "analyse", str(d), "--no-plots"], check=True,
+                       capture_output=True, timeout=300)
+        outcomes.append(json.loads((d / "outcome.json").read_text()))
+    for key in ("stop_reason", "stop_step", "n_largest", "n_fragments", "contacts_per_particle",
+                "gyration_radius_largest", "dissipated_fraction", "energy_error"):
+        assert outcomes[1][key] == outcomes[0][key], key
+    frames = [(d / "frames.csv").read_text().splitlines()[1:] for d in (straight, cut)]
+    assert [r.split(",")[0] for r in frames[1]] == [r.split(",")[0] for r in frames[0]]
+    log = (cut / "log.lammps").read_text()
+    assert log.count("Reading restart file") == 1 and log.count("Reading data file") == 1
+    kept = (cut / "outcome.json").stat().st_mtime_ns
+    refused = subprocess.run([JKRDT, "run", str(cut), *rule], capture_output=True, text=True,
+                             timeout=120)
+    assert refused.returncode == 2 and "holds a finished run (settled at step" in refused.stderr
+    assert "--force" in refused.stderr and (cut / "outcome.json").stat().st_mtime_ns == kept
