@@ -61,10 +61,14 @@ def test_a_run_cut_off_continues_as_the_uninterrupted_one_and_a_finished_one_is_
     run.send_signal(signal.SIGINT)
     run.communicate(timeout=20)
     assert run.returncode == 2 and not (cut / "final.restart").exists(), "ended before the cut"
+    subprocess.run([JKRDT, "analyse", str(cut), "--partial", "--no-plots"], check=True,
+                   capture_output=True, timeout=300)
+    assert json.loads((cut / "outcome.json").read_text())["stop_reason"] == "cut off"
     again = subprocess.run([JKRDT, "run", str(cut), *rule], capture_output=True, text=True,
                            timeout=600)
     assert again.returncode == 0, again.stderr
     assert "continuing the run that was cut off, from restart." in again.stdout
+    assert not (cut / "outcome.json").exists()       # no stale outcome beside a newer log
     outcomes = []
     for d in (straight, cut):
         subprocess.run([JKRDT, "analyse", str(d), "--no-plots"], check=True,

@@ -202,6 +202,8 @@ def run_scene(out: Path, dt: float | None, steps: int | None, nproc: int,
     if resume is not None:
         restart, start = resume
         campaign_module.cut_back(out, start)
+        for stale in scene_module.ANALYSIS_OUTPUTS:     # of an earlier --partial analysis
+            (out / stale).unlink(missing_ok=True)
         variables.update(read="read_restart", file=restart.name, append="yes",
                          steps=int(variables["steps"]) - start)
         print(f"continuing the run that was cut off, from {restart.name} at step {start}")

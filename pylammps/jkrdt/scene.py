@@ -51,9 +51,11 @@ RUN_OUTPUTS = (ATOMS, CONTACTS, CHECKS, LOG)
 FINAL_RESTART, FINAL_DUMP = "final.restart", "final.dump.gz"
 ROLLING_RESTARTS = ("restart.a", "restart.b")
 #: what a scene directory holds once set up, run and analysed (all that a fresh scene clears)
-SCENE_FILES = (DATA, META, DECK, *RUN_OUTPUTS, "frames.csv", "outcome.json", "outcome.png",
-               "outcome.pdf", "energy.png", "energy.pdf", "timeline.png", "timeline.pdf",
-               *ROLLING_RESTARTS, FINAL_RESTART, FINAL_DUMP)
+#: what jkrdt analyse writes into a run directory
+ANALYSIS_OUTPUTS = ("frames.csv", "outcome.json", "outcome.png", "outcome.pdf", "energy.png",
+                    "energy.pdf", "timeline.png", "timeline.pdf")
+SCENE_FILES = (DATA, META, DECK, *RUN_OUTPUTS, *ANALYSIS_OUTPUTS, *ROLLING_RESTARTS,
+               FINAL_RESTART, FINAL_DUMP)
 
 
 def pair_coeff(mat: Material, model: str = "frictional") -> str:
