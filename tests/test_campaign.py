@@ -230,6 +230,9 @@ def test_a_campaign_directory_belongs_to_one_spec(tmp_path):
     record = json.loads((tmp_path / "runs" / "campaign.json").read_text())
     assert record["spec"]["model"] == "frictional" and record["versions"] == ["0.1.0"]
     assert record["spec"]["settle"]["window"] == 5              # the rule written out in full
+    spec.write_text(json.dumps(dict(one, v_col=[20], settle=dict(SPEC["settle"], window=5))))
+    same = jkrdt_campaign(spec, tmp_path / "runs")          # the same spec, written otherwise
+    assert same.returncode == 0 and "0 run(s) done, 1 already finished" in same.stdout
     spec.write_text(json.dumps(dict(one, model="frictionless")))
     refused = jkrdt_campaign(spec, tmp_path / "runs")
     assert refused.returncode == 2 and refused.stderr.count("\n") == 1, refused.stderr

@@ -163,6 +163,17 @@ def spec_record(spec: dict) -> dict:
     return json.loads(json.dumps(record))
 
 
+def as_numbers(value):
+    """``value`` with every number a float, so that 20 and 20.0 are one speed."""
+    if isinstance(value, bool) or value is None or isinstance(value, str):
+        return value
+    if isinstance(value, (int, float)):
+        return float(value)
+    if isinstance(value, list):
+        return [as_numbers(v) for v in value]
+    return {k: as_numbers(v) for k, v in value.items()}
+
+
 def own(campaign: Path, spec: dict, fresh: bool = False) -> None:
     """Make ``campaign`` the directory of ``spec``: record it there, or raise naming how the
     spec it holds differs; ``fresh`` deletes the runs it holds first."""
@@ -178,7 +189,7 @@ def own(campaign: Path, spec: dict, fresh: bool = False) -> None:
     elif path.exists():
         had = json.loads(path.read_text())
         differ = [k for k in sorted(set(had["spec"]) | set(want))
-                  if had["spec"].get(k) != want.get(k)]
+                  if as_numbers(had["spec"].get(k)) != as_numbers(want.get(k))]
         if differ:
             said = "; ".join(f'"{k}" was {had["spec"].get(k)!r}, now {want.get(k)!r}'
                              for k in differ[:3])
