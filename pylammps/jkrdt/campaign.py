@@ -174,6 +174,13 @@ def as_numbers(value):
     return {k: as_numbers(v) for k, v in value.items()}
 
 
+def drop_runs(campaign: Path) -> None:
+    """Delete the run directories of ``campaign`` (its v<v_col>/ folders), nothing else."""
+    for speed in campaign.glob("v*"):
+        if speed.is_dir() and any(speed.glob("b2_*/seed*")):
+            shutil.rmtree(speed)
+
+
 def own(campaign: Path, spec: dict, fresh: bool = False) -> None:
     """Make ``campaign`` the directory of ``spec``: record it there, or raise naming how the
     spec it holds differs; ``fresh`` deletes the runs it holds first."""
@@ -183,8 +190,7 @@ def own(campaign: Path, spec: dict, fresh: bool = False) -> None:
     want = spec_record(spec)
     versions = [__version__]
     if path.exists() and fresh:
-        for run in campaign.glob("v*"):
-            shutil.rmtree(run)
+        drop_runs(campaign)
         path.unlink()
     elif path.exists():
         had = json.loads(path.read_text())
@@ -202,8 +208,7 @@ def own(campaign: Path, spec: dict, fresh: bool = False) -> None:
                          "unknown: give another directory, or --fresh to delete its runs and "
                          "start afresh")
     elif fresh:
-        for run in campaign.glob("v*"):
-            shutil.rmtree(run)
+        drop_runs(campaign)
     campaign.mkdir(parents=True, exist_ok=True)
     write_json(path, dict(spec=want, versions=versions))
 
