@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from jkrdt.scene import ATOMS, CONTACTS
+from jkrdt.rundir import ATOMS, CONTACTS
 
 #: columns of compute jkr/dt/contacts, in the order of the local dump
 CONTACT_COLUMNS = ["id1", "id2", "delta", "a", "force", "zeta", "xi", "phi"]
@@ -169,7 +169,7 @@ def frames(run, atoms=ATOMS, contacts=CONTACTS) -> Iterator[Frame]:
     """The frames of a run directory: positions and radii from ``atoms``, joined by
     timestep to the contact list of ``contacts`` when that file exists. They end at the
     last frame both files hold whole (MDAnalysis drops a cut-off last atoms frame; a
-    cut-off contact snapshot ends the frames there), which ``analysis.status`` then
+    cut-off contact snapshot ends the frames there), which ``jkrdt.rundir.run_status`` then
     reports as a run cut off."""
     run = Path(run)
     u = atoms_universe(run / atoms)

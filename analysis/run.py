@@ -1,7 +1,7 @@
 """Analysis of one run directory, written by ``jkrdt setup`` + ``jkrdt run``, the deck
 ``inputs/collision.lmp``, or ``jkrdt.session.Session``. It composes the reading
 (analysis.dumps), the per-frame measures (analysis.outcome.CollisionOutcome, an
-MDAnalysis AnalysisBase), the energy ledger (analysis.thermo) and the writers
+MDAnalysis AnalysisBase), the log (jkrdt.rundir: thermo, status) and the writers
 (analysis.tables, analysis.plots):
 
     collision.json, log.lammps, checks.csv, atoms.dump.gz, contacts.dump.gz   ->
@@ -18,16 +18,15 @@ from pathlib import Path
 
 import numpy as np
 
-from jkrdt import scene as scene_module
+from jkrdt import rundir
+from jkrdt.rundir import read_thermo, run_status
 from jkrdt.ledger import CHANNELS, energy_budget, energy_error
 from jkrdt.stopping import ENERGY_WARN, STOP_WORDS
 
 from .dumps import atoms_universe
 from .outcome import CollisionOutcome, energy_scalings, from_checks
 from .plots import energy_partition, outcome, timeline
-from .status import run_status
-from .tables import read_csv, write_csv, write_json
-from .thermo import read_thermo
+from .tables import read_csv, write_csv
 
 
 class RunNotComplete(ValueError):
@@ -54,14 +53,14 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
                 partial: bool = False) -> dict:
     """Analyse ``run``; returns what ``outcome.json`` holds. ``tolerance`` (m, default
     delta_c) is used only when the run has no contact dump. A run that failed or was
-    cut off (see ``analysis.status``) raises ``RunNotComplete`` unless ``partial``, which
-    analyses the frames there are and records the stop reason."""
+    cut off (``jkrdt.rundir.run_status``) raises ``RunNotComplete`` unless ``partial``,
+    which analyses the frames there are and records the stop reason."""
     run = Path(run)
-    if not (run / scene_module.META).exists():
+    if not (run / rundir.META).exists():
         raise FileNotFoundError(f"{run} has no collision.json: analyse a directory written by "
-                                "'jkrdt setup' (jkrdt.scene.write) and run there")
-    meta = scene_module.read_metadata(run)
-    scene = scene_module.from_metadata(meta)
+                                "'jkrdt setup' (jkrdt.rundir.write) and run there")
+    meta = rundir.read_metadata(run)
+    scene = rundir.from_metadata(meta)
     status = run_status(run)
     if status.stop_reason == "error" and not partial:
         raise RunNotComplete(f"{run}: {status.problem}; analyse what is there with --partial")
@@ -69,12 +68,12 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
     tolerance = s.delta_c if tolerance is None else tolerance
     n_tar, n_pro = scene.n_tar, scene.n_pro
     budget, thermo = None, None
-    if (run / scene_module.LOG).exists():
-        thermo = read_thermo(run / scene_module.LOG)
+    if (run / rundir.LOG).exists():
+        thermo = read_thermo(run / rundir.LOG)
         budget = energy_budget(thermo)
-    atoms, contacts, checks = (run / name for name in (scene_module.ATOMS,
-                                                        scene_module.CONTACTS,
-                                                        scene_module.CHECKS))
+    atoms, contacts, checks = (run / name for name in (rundir.ATOMS,
+                                                        rundir.CONTACTS,
+                                                        rundir.CHECKS))
     if not atoms.exists():
         raise FileNotFoundError(f"{atoms} does not exist: run the scene first ('jkrdt run "
                                 f"{run}')" + (f" ({status.problem})" if status.problem else ""))
@@ -107,11 +106,7 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
         raise RunNotComplete(f"{run}: {status.problem}; analyse what is there with --partial")
     n_k = n_tar + n_pro - 2
     sizes, cumulative = measured.fragment_sizes, measured.N_cum
-    out = dict(run=str(run), N_tar=n_tar, N_pro=n_pro, v_col=scene.v_col,
-               B_off=scene.b_off, seed=scene.seed, model=scene.model,
-               kind=scene.kind, dimension=scene.dim,
-               material=mat.name, xi_crit=mat.xi_crit, tvis=mat.tvis, radius=scene.radius,
-               E_imp=meta["E_imp"], n_k=n_k, E_roll=s.E_roll, E_break=s.E_break,
+    out = dict(rundir.parameters(run, meta), E_imp=meta["E_imp"], n_k=n_k, E_roll=s.E_roll, E_break=s.E_break,
                **energy_scalings(meta["E_imp"], n_k, s.E_roll, s.E_break),
                **final, fragment_sizes=sizes.tolist(), N_cum=cumulative.tolist(),
                contacts_source="contact list" if measured.has_contacts else
@@ -127,14 +122,21 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
         error = energy_error(budget, e_imp)
         t_end = float(thermo["Time"][at[0]] if at.size else thermo["Time"][upto][-1])
         out.update(time_end=t_end, time_end_over_tc=t_end / s.t_c)
-        gone = budget["departed"][at[0]] if at.size else budget["departed"][upto][-1]
-        out.update(kinetic_left=float(left / e_imp), kinetic_departed=float(gone / e_imp),
+        end = int(at[0]) if at.size else int(np.flatnonzero(upto)[-1])
+        gone = budget["departed"][end]
+        # the partition of the energy at the start, at the end: kinetic_start = kinetic_left
+        # + potential_change + dissipated_fraction - energy_drift (all / E_imp)
+        out.update(kinetic_start=float(budget["kinetic"][0] / e_imp),
+                   kinetic_left=float(left / e_imp), kinetic_departed=float(gone / e_imp),
+                   potential_change=float((budget["potential"][end] - budget["potential"][0])
+                                          / e_imp),
+                   energy_drift=float((budget["total"][end] - budget["total"][0]) / e_imp),
                    energy_error=error,
                    energy_warning=error > ENERGY_WARN,
-                   dissipated_fraction=float(budget["dissipated"][-1] / e_imp),
-                   dissipated_by_channel={name: float(budget[name][-1] / e_imp)
+                   dissipated_fraction=float(budget["dissipated"][end] / e_imp),
+                   dissipated_by_channel={name: float(budget[name][end] / e_imp)
                                           for name in CHANNELS})
-    write_csv(run / "frames.csv", rows)
+    write_csv(run / rundir.FRAMES, rows)
     if plots:
         title = (f"{mat.name} {scene.kind.upper()} {n_tar}+{n_pro}, "
                  f"v = {scene.v_col:g} m/s, B_off = {scene.b_off:g}, {scene.model}")
@@ -153,7 +155,7 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
             pictures += energy_partition(run / "energy", thermo["Time"], budget, meta["E_imp"],
                                          title)
         out["pictures"] = [str(p) for p in pictures]
-    write_json(run / "outcome.json", out)
+    rundir.write_outcome(run, out)
     return out
 
 
@@ -188,6 +190,11 @@ def summary_text(out: dict) -> str:
         lines.append(f"dissipated / E_imp          {out['dissipated_fraction']:.3f}  ("
                      + ", ".join(f"{k} {v:.3f}" for k, v in out["dissipated_by_channel"].items())
                      + ")")
+    if "potential_change" in out:
+        lines.append(f"energy partition / E_imp    kinetic {out['kinetic_left']:.3f} + potential "
+                     f"change {out['potential_change']:+.3f} + dissipated "
+                     f"{out['dissipated_fraction']:.3f} - drift {out['energy_drift']:+.1e} = "
+                     f"{out['kinetic_start']:.3f}, the kinetic energy at the start")
         lines.append(f"max |dE| / E_imp            {out['energy_error']:.2e}"
                      + (f"  WARNING: above {ENERGY_WARN:g}; use a smaller --dt"
                         if out["energy_warning"] else ""))

@@ -16,10 +16,12 @@ from pathlib import Path
 
 import numpy as np
 
+from jkrdt import rundir
+from jkrdt.rundir import write_json
 from jkrdt.stopping import COMPLETE
 
 from . import plots
-from .tables import write_csv, write_json
+from .tables import write_csv
 
 SCALARS = ["model", "material", "xi_crit", "tvis", "kind", "dimension", "N_tar", "N_pro",
            "v_col", "B_off", "seed", "radius", "E_imp", "n_k", "E_imp_over_nk_Eroll",
@@ -74,7 +76,7 @@ def label(run: dict) -> str:
 
 
 def load_outcomes(campaign) -> list[dict]:
-    return [json.loads(p.read_text()) for p in sorted(Path(campaign).rglob("outcome.json"))]
+    return [json.loads(p.read_text()) for p in sorted(Path(campaign).rglob(rundir.OUTCOME))]
 
 
 def summarise(campaign, plot: bool = True, include_cap: bool = False) -> dict:

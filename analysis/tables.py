@@ -1,25 +1,13 @@
-"""Results files: CSV tables (one row per frame or per run) and JSON, written to a
-temporary name and renamed, so a reader never sees half a file and an interrupted
-write never replaces a finished one."""
+"""Results tables: CSV, one row per frame or per run, written atomically
+(``jkrdt.atomic``: a reader never sees half a file)."""
 
 from __future__ import annotations
 
 import csv
 import io
-import json
 from pathlib import Path
 
-
-def write_atomic(path, text: str) -> Path:
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text)
-    tmp.replace(path)
-    return path
-
-
-def write_json(path, data) -> Path:
-    return write_atomic(path, json.dumps(data, indent=2, default=float) + "\n")
+from jkrdt.atomic import write_atomic
 
 
 def write_csv(path, rows: list[dict]) -> Path:

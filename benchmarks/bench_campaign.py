@@ -41,9 +41,11 @@ def command(name: str, spec: Path, where: Path) -> list[str]:
 
 
 def outcomes(where: Path) -> dict:
+    from jkrdt import rundir
+
     keys = ("n_largest", "n_fragments", "stop_step")
     return {str(p.relative_to(where)): [json.loads(p.read_text())[k] for k in keys]
-            for p in sorted(where.rglob("outcome.json"))}
+            for p in sorted(where.rglob(rundir.OUTCOME))}
 
 
 def main() -> int:

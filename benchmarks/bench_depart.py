@@ -44,13 +44,14 @@ def main(argv=None) -> None:
                          "special case, jkrdt.scene.NSQ_MAX)")
     args = ap.parse_args(argv)
 
+    from jkrdt import rundir
     from jkrdt import scene as scene_module
     from jkrdt.materials import material
 
     work = Path(tempfile.mkdtemp())
     sc = scene_module.Scene(material=material("ice"), n_tar=args.n, n_pro=args.n, v_col=args.v,
                             model=args.model, seed=args.seed)
-    scene_module.write(work / "scene", sc)
+    rundir.write(work / "scene", sc)
     variants = (dict(yes=dict(depart="yes"), no=dict(depart="no")) if not args.neighbor else
                 dict(yes=dict(depart="yes", neighbor="bin", sort="1000 0.0"),
                      no=dict(depart="yes", neighbor="nsq", sort="0 0.0")))

@@ -27,7 +27,6 @@ import json
 import os
 import platform
 import re
-import shutil
 import subprocess
 import sys
 import tempfile
@@ -73,12 +72,14 @@ CONFIGS = {"serial": (1, 1), "mpi2": (2, 1), "omp2": (1, 2)}      # (ranks, thre
 
 def scene(n: int, where: Path) -> Path:
     """The 2 x n BPCA scene's data file, built by jkrdt setup once."""
+    from jkrdt import rundir
+
     out = where / f"bpca_{n}x2"
-    if not (out / "collision.data").exists():
+    if not (out / rundir.DATA).exists():
         subprocess.run([str(BIN / "jkrdt"), "setup", "--n-tar", str(n), "--n-pro", str(n),
                         "--v", "20", "--b-off", "0.3", "--seed", "3", "--force",
                         "--out", str(out)], check=True)
-    return (out / "collision.data").resolve()
+    return (out / rundir.DATA).resolve()
 
 
 def lammps_command(ranks: int, threads: int, plugin: Path | None) -> tuple[list, dict]:

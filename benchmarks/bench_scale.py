@@ -58,10 +58,10 @@ jump SELF chunk
 
 
 def imbalance(scene: Path, ranks: int, balance_tc: float, balance: str = "rcb") -> dict:
-    from jkrdt import scene as scene_module
+    from jkrdt import rundir
     from jkrdt.stopping import DEFAULT_RULE
 
-    sc = scene_module.from_metadata(scene_module.read_metadata(scene))
+    sc = rundir.read(scene)
     variables = dict(DEFAULT_RULE.deck_variables(sc.time_step(None)[0]), balance=balance)
     every = int(variables["every"])
     chunks = max(1, round(balance_tc / DEFAULT_RULE.check_tc))
@@ -113,6 +113,7 @@ def main(argv=None) -> None:
         args.sizes, args.until_tc, args.ranks = [300], 200.0, [2]
         args.balance_n, args.balance_tc = 300, 200.0
 
+    from jkrdt import rundir
     from jkrdt import scene as scene_module
     from jkrdt.materials import material
 
@@ -123,7 +124,7 @@ def main(argv=None) -> None:
         if not where.exists():
             sc = scene_module.Scene(material=material("ice"), n_tar=n, n_pro=n, v_col=args.v,
                                     model=args.model, seed=args.seed)
-            scene_module.write(where, sc)
+            rundir.write(where, sc)
         return where
 
     out = dict(scene=dict(v_col=args.v, model=args.model, seed=args.seed, material="ice",

@@ -65,11 +65,12 @@ MODELS = {"frictional": dict(model="frictional", tvis=0.0),
 
 def write_scene(directory: Path, scene: dict, seed: int, n: int | None = None,
                 model: str | None = None, tvis: float = 0.0) -> Path:
+    from jkrdt import rundir
     from jkrdt import scene as scene_module
     from jkrdt.materials import material
 
     n = n or scene["n"]
-    return scene_module.write(directory, scene_module.Scene(
+    return rundir.write(directory, scene_module.Scene(
         material("ice", xi_crit=scene["xi_crit"], tvis=tvis), n, n, v_col=scene["v"],
         b_off=scene["b_off"], seed=seed, kind=scene["kind"], dim=scene["dim"],
         model=model or scene["model"]))
@@ -347,7 +348,8 @@ def main(argv=None) -> int:
     p.add_argument("--plot", action="store_true",
                    help="redraw tradeoff.png/pdf from an existing tradeoff.json")
     args = p.parse_args(argv)
-    from jkrdt.analysis.tables import write_csv, write_json
+    from jkrdt.analysis.tables import write_csv
+    from jkrdt.rundir import write_json
 
     if args.table:
         print(markdown(json.loads((Path(args.out) / "tradeoff.json").read_text())))

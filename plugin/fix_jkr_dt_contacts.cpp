@@ -37,6 +37,7 @@ FixJKRDTContacts::FixJKRDTContacts(LAMMPS *lmp, int narg, char **arg) :
   mask = utils::inumeric(FLERR, arg[3], false, lmp);
   dnum = layout_size(mask, field_offset);
 
+  restart_global = 1;
   restart_peratom = 1;
   create_attribute = 1;
   peratom_flag = 1;
@@ -581,6 +582,32 @@ int FixJKRDTContacts::maxsize_restart()
   for (int i = 0; i < atom->nlocal; i++) nmine = std::max(nmine, npartner[i]);
   MPI_Allreduce(&nmine, &nall, 1, MPI_INT, MPI_MAX, world);
   return 4 + nall * (1 + dnum) + NLEDGER;    // as size_restart()
+}
+
+/* ----------------------------------------------------------------------
+   restart, global part: the layout mask and the pair style's made_with. It is
+   read before the atoms' records, so a file's fields all come back (the
+   layout widened to them) for the pair style to book those it switched off
+------------------------------------------------------------------------- */
+
+void FixJKRDTContacts::write_restart(FILE *fp)
+{
+  std::vector<double> list = {static_cast<double>(mask), static_cast<double>(made_with.size())};
+  list.insert(list.end(), made_with.begin(), made_with.end());
+  if (comm->me == 0) {
+    const int size = static_cast<int>(list.size() * sizeof(double));
+    fwrite(&size, sizeof(int), 1, fp);
+    fwrite(list.data(), sizeof(double), list.size(), fp);
+  }
+}
+
+void FixJKRDTContacts::restart(char *buf)
+{
+  const auto *list = reinterpret_cast<const double *>(buf);
+  const int filemask = static_cast<int>(list[0]);
+  const auto n = static_cast<size_t>(list[1]);
+  made_with.assign(list + 2, list + 2 + n);
+  set_layout(mask | filemask);
 }
 
 /* ---------------------------------------------------------------------- */

@@ -42,7 +42,7 @@
 
 #include "fix.h"
 
-#include "pair_jkr_dt.h"
+#include "jkr_dt_contact.h"
 
 #include <vector>
 
@@ -117,6 +117,8 @@ class FixJKRDTContacts : public Fix {
   void unpack_restart(int, int) override;
   int size_restart(int) override;
   int maxsize_restart() override;
+  void write_restart(FILE *) override;
+  void restart(char *) override;
   double memory_usage() override;
 
   int *npartner;        // number of bonded contacts of each atom
@@ -126,11 +128,12 @@ class FixJKRDTContacts : public Fix {
   tagint *owner;        // the atom's ID when its contacts were stored (renumbering check)
   int dnum;             // doubles per contact under the current layout
 
-  // what the stored state was made with, as of the last run's end (set by the pair style):
-  // the resolved constants of every type pair, so that a pair style that takes the contacts
-  // over can book the springs of a channel switched off, and the atom count, so that it can
-  // tell deleted partners from renumbered ones
-  std::vector<PairJKRDT::Param> made_with;
+  // what the stored state was made with, kept for the pair style, which writes and reads it:
+  // its record of the constants of every type pair (opaque here; it goes into restart files
+  // with the contacts), so that a pair style that takes the contacts over, in this run or
+  // from a restart file, can book the springs of a channel switched off; and the atom count
+  // at the last run's end, so that it can tell deleted partners from renumbered ones
+  std::vector<double> made_with;
   bigint natoms_at_run_end;
 
  private:

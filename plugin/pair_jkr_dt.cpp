@@ -171,11 +171,15 @@ void PairJKRDT::init_style()
   if (fix) {
     fix_contacts = dynamic_cast<Contacts *>(fix);
     if (!fix_contacts) error->all(FLERR, "fix ID {} is reserved for pair jkr/dt", FIX_ID);
-    fix_contacts->set_layout(layout_mask());
   } else {
+    // contacts read from a restart file come back in the new fix with what they were made
+    // with, so a channel switched off since is booked as between two runs
     fix_contacts = dynamic_cast<Contacts *>(
         modify->add_fix(fmt::format("{} all jkr/dt/contacts {}", FIX_ID, layout_mask())));
+    book_channels_switched_off(param, *fix_contacts);
   }
+  fix_contacts->set_layout(layout_mask());
+  fix_contacts->made_with = made_with_record(param);
 }
 
 /* ----------------------------------------------------------------------

@@ -130,6 +130,11 @@ class PairJKRDT : public Pair {
   Param resolve(int i, int j) const;
   int layout_mask() const;
   void book_channels_switched_off(const std::vector<Param> &fresh, FixJKRDTContacts &C);
+  // the constants of every type pair as the contact fix keeps them (made_with) and restart
+  // files carry them: each Param's bytes behind their size; another build's record reads
+  // back empty
+  static std::vector<double> made_with_record(const std::vector<Param> &param);
+  static std::vector<Param> made_with_params(const std::vector<double> &record);
   void find_max_radii();
   void check_periodic_images(double cutmax);
   void check_neighbor_settings() const;

@@ -362,7 +362,6 @@ void PairJKRDT::report_run()
   step_max = 0.0;
   contacts_at_run_end = fix_contacts->count();
   fix_contacts->natoms_at_run_end = atom->natoms;
-  fix_contacts->made_with = param;
   if (step_warned || most <= STEP_WARN) return;
   step_warned = true;
   if (comm->me == 0)

@@ -4,6 +4,7 @@ finders agree on every frame after impact. A 64 + 64 grain head-on collision at
 60 m/s, frictionless, E_imp ~ 12 n_k E_break: well past catastrophic disruption."""
 
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -12,6 +13,7 @@ import numpy as np
 import pytest
 
 from conftest import ICE_SCALES as S, R_GRAIN as R
+from jkrdt import rundir
 from jkrdt import scene as scene_module
 from jkrdt.analysis import fragments as frag
 from jkrdt.analysis.dumps import frames, iter_local
@@ -27,7 +29,7 @@ N = 64
 @pytest.fixture(scope="module")
 def run(tmp_path_factory):
     d = tmp_path_factory.mktemp("run")
-    scene_module.write(d, scene_module.Scene(ICE, N, N, v_col=60.0, seed=11,
+    rundir.write(d, scene_module.Scene(ICE, N, N, v_col=60.0, seed=11,
                                              model="frictionless"))
     with Session(d, d, every=1000) as session:
         session.run(12000, chunk=1000, progress=False)
@@ -87,6 +89,14 @@ def test_outcome_of_a_disruptive_collision(run):
     assert sum(out["dissipated_by_channel"].values()) == pytest.approx(
         out["dissipated_fraction"], rel=1e-12)
     assert out["dissipated_by_channel"]["rolling"] == 0.0           # frictionless
+    # the partition adds up: two aggregates without spin in their centre-of-mass frame start
+    # with E_imp of kinetic energy, and it goes into kinetic, potential and dissipated
+    # energy, less the integration's drift
+    # (to the 10 digits of the log's thermo rows)
+    assert out["kinetic_start"] == pytest.approx(1.0, rel=1e-9)
+    assert (out["kinetic_left"] + out["potential_change"] + out["dissipated_fraction"]
+            - out["energy_drift"]) == pytest.approx(out["kinetic_start"], rel=1e-9)
+    assert abs(out["energy_drift"]) <= out["energy_error"]
 
 
 def test_frames_table_matches_the_session(run):
@@ -104,7 +114,7 @@ def test_frames_table_matches_the_session(run):
 
 def test_local_dump_stream(run):
     d, *_ = run
-    steps = [step for step, _ in iter_local(d / scene_module.CONTACTS)]
+    steps = [step for step, _ in iter_local(d / rundir.CONTACTS)]
     assert steps == list(range(0, 12001, 1000))
 
 
@@ -114,6 +124,12 @@ def test_analyse_command(run):
                           text=True, check=True, timeout=120)
     out = json.loads((d / "outcome.json").read_text())
     assert f"largest remnant N_lar       {out['n_largest']}" in done.stdout
+    # the summary shows every term of the partition, and they add up to the start's 1.000
+    [line] = [x for x in done.stdout.splitlines() if x.startswith("energy partition / E_imp")]
+    kinetic, potential, dissipated, drift, start = map(float, re.findall(
+        r"[-+]?\d+\.\d+(?:e[-+]?\d+)?", line))
+    assert start == pytest.approx(1.0, abs=5e-4)
+    assert kinetic + potential + dissipated - drift == pytest.approx(start, abs=2e-3)
     for name in ("outcome.png", "outcome.pdf", "timeline.png", "timeline.pdf", "energy.png",
                  "energy.pdf"):
         assert (d / name).stat().st_size > 0
@@ -126,16 +142,16 @@ def test_collision_outcome_is_an_mdanalysis_analysis(run):
     from jkrdt.analysis.outcome import CollisionOutcome
     d, *_ = run
     rows = read_csv(d / "frames.csv")
-    u = atoms_universe(d / scene_module.ATOMS)
-    full = CollisionOutcome(u, N, N, contacts=d / scene_module.CONTACTS).run()
+    u = atoms_universe(d / rundir.ATOMS)
+    full = CollisionOutcome(u, N, N, contacts=d / rundir.CONTACTS).run()
     assert list(full.results.step) == list(range(0, 12001, 1000))
     for name in ("n_largest", "n_fragments", "contacts_per_particle", "growth_efficiency"):
         assert np.allclose(full.results[name], [float(r[name]) for r in rows]), name
-    sliced = CollisionOutcome(u, N, N, contacts=d / scene_module.CONTACTS).run(start=2, stop=11,
+    sliced = CollisionOutcome(u, N, N, contacts=d / rundir.CONTACTS).run(start=2, stop=11,
                                                                          step=3)
     assert list(sliced.results.step) == [2000, 5000, 8000]
     assert np.array_equal(sliced.results.n_largest, full.results.n_largest[2:11:3])
-    backwards_again = CollisionOutcome(u, N, N, contacts=d / scene_module.CONTACTS).run(stop=3)
+    backwards_again = CollisionOutcome(u, N, N, contacts=d / rundir.CONTACTS).run(stop=3)
     assert list(backwards_again.results.step) == [0, 1000, 2000]
     # without the contact dump: fragments from positions within delta_c, the same at the end
     by_positions = CollisionOutcome(u, N, N, tolerance=S.delta_c).run(start=12)
@@ -148,7 +164,7 @@ def test_two_single_grains_are_analysed_without_the_aggregate_units(tmp_path):
     # n_k = N_tar + N_pro - 2 = 0: E_imp / (n_k E_roll) and / (n_k E_break) are undefined, so
     # the outcome says None for them instead of dividing by zero; at 3 m/s (half the
     # elastic sticking threshold, tests/test_collision_energy.py) the pair sticks
-    scene_module.write(tmp_path, scene_module.Scene(ICE, 1, 1, v_col=3.0, seed=1))
+    rundir.write(tmp_path, scene_module.Scene(ICE, 1, 1, v_col=3.0, seed=1))
     done = subprocess.run([str(BIN / "jkrdt"), "run", str(tmp_path)], capture_output=True,
                           text=True, timeout=120)
     assert done.returncode == 0, done.stderr

@@ -15,6 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from jkrdt import rundir
+
 from jkrdt import scene as scene_module
 from jkrdt.analysis import dumps
 from jkrdt.analysis.outcome import from_checks, measure_frame
@@ -30,8 +32,8 @@ N = 100
 
 def run_deck(directory: Path, **words) -> None:
     variables = dict(RULE.deck_variables(0.014), **words)
-    cmd = [str(BIN / "mpirun"), "-np", "2", str(BIN / "lmp"), "-in", scene_module.DECK,
-           "-log", scene_module.LOG, "-screen", "none"]
+    cmd = [str(BIN / "mpirun"), "-np", "2", str(BIN / "lmp"), "-in", rundir.DECK,
+           "-log", rundir.LOG, "-screen", "none"]
     for name, value in variables.items():
         cmd += ["-var", name, str(value)]
     subprocess.run(cmd, cwd=directory, check=True, timeout=900)
@@ -43,7 +45,7 @@ def runs(tmp_path_factory):
     out = {}
     for name, frames in (("every", 1), ("sparse", None)):
         d = tmp_path_factory.mktemp(name)
-        scene_module.write(d, scene_module.Scene(ICE, N, N, v_col=39.8, seed=1,
+        rundir.write(d, scene_module.Scene(ICE, N, N, v_col=39.8, seed=1,
                                                  model="frictionless"))
         run_deck(d, **({} if frames is None else dict(frames=frames)))
         out[name] = d
@@ -53,7 +55,7 @@ def runs(tmp_path_factory):
 def test_the_table_equals_the_analysis_of_every_frame(runs):
     run = runs["every"]
     table = {row["step"]: row for row in
-             from_checks(read_csv(run / scene_module.CHECKS), N, N)}
+             from_checks(read_csv(run / rundir.CHECKS), N, N)}
     seen = 0
     for frame in dumps.frames(run):
         labels, measured = measure_frame(frame, N, N)
@@ -80,7 +82,7 @@ def test_the_table_equals_the_analysis_of_every_frame(runs):
     # last frame marks as departed, whole fragments of it
     departed = last["departed_grains"]
     assert departed > 0
-    at = dumps.atoms_universe(run / scene_module.ATOMS)
+    at = dumps.atoms_universe(run / rundir.ATOMS)
     at.trajectory[-1]
     gone = np.asarray(at.trajectory.ts.data[dumps.DEPARTED_AT]) > 0
     assert gone.sum() == departed
@@ -89,7 +91,7 @@ def test_the_table_equals_the_analysis_of_every_frame(runs):
 def test_the_sparse_record_gives_the_same_outcome(runs):
     full = analyse_run(runs["every"], plots=False)
     sparse = analyse_run(runs["sparse"], plots=False)
-    universe = dumps.atoms_universe(runs["sparse"] / scene_module.ATOMS)
+    universe = dumps.atoms_universe(runs["sparse"] / rundir.ATOMS)
     steps = [int(ts.data["step"]) for ts in universe.trajectory]
     assert steps[0] == 0 and steps[-1] == sparse["stop_step"] and len(steps) <= 3
     for key in ("n_largest", "n_second", "n_fragments", "fragment_sizes", "N_cum",

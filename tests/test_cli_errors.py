@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from jkrdt import scene as scene_module
+from jkrdt import rundir
 from jkrdt.analysis.dumps import iter_local
 
 JKRDT = str(Path(sys.executable).parent / "jkrdt")
@@ -54,12 +54,12 @@ def test_analyse_of_a_directory_that_is_no_scene(tmp_path):
 def test_setup_refuses_a_used_directory_unless_forced(tmp_path):
     setup = ["setup", "--kind", "bcca", "--dim", "2", "--n-tar", "8", "--n-pro", "8",
              "--out", tmp_path]
-    (tmp_path / scene_module.ATOMS).write_text("an earlier run's dump")
+    (tmp_path / rundir.ATOMS).write_text("an earlier run's dump")
     (tmp_path / "notes.txt").write_text("the user's own file")
     one_line_error(setup, "is not empty; choose another --out, or give --force")
     code, err = jkrdt(*setup, "--force")
     assert code == 0, err
-    assert not (tmp_path / scene_module.ATOMS).exists()                 # what it owns is cleared
+    assert not (tmp_path / rundir.ATOMS).exists()                 # what it owns is cleared
     assert (tmp_path / "notes.txt").read_text() == "the user's own file"
     assert (tmp_path / "collision.json").exists()
 
@@ -81,6 +81,18 @@ SPEC = dict(n_tar=8, n_pro=8, v_col=[10], b_off2=[0.0])
 def test_campaign_spec_errors_name_the_key(tmp_path, change, match):
     spec = tmp_path / "spec.json"
     spec.write_text(json.dumps(dict(SPEC, **change)))
+    one_line_error(["campaign", spec, tmp_path / "runs"], match)
+    assert not (tmp_path / "runs").exists()
+
+
+@pytest.mark.parametrize("text, match", [
+    ('{"n_tar": 8, "n_pro": 8,', "spec.json is not valid JSON: Expecting"),
+    ("[8, 8]", "spec.json: a campaign spec is a JSON object of keys"),
+    (json.dumps(dict(SPEC, n_tar=2 ** 30)), "grains need about"),
+])
+def test_campaign_spec_files_that_cannot_run_are_named(tmp_path, text, match):
+    spec = tmp_path / "spec.json"
+    spec.write_text(text)
     one_line_error(["campaign", spec, tmp_path / "runs"], match)
     assert not (tmp_path / "runs").exists()
 

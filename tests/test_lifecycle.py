@@ -10,7 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import ICE_SCALES as S, R_GRAIN, ledger, two_grain_scene
+from conftest import ENERGY_THERMO, ICE_SCALES as S, R_GRAIN, ledger, two_grain_scene
+from jkrdt import rundir
 from jkrdt import scene as scene_module
 from jkrdt.materials import ICE
 from jkrdt.session import start_lammps
@@ -101,7 +102,7 @@ def test_restart_files_written_before_owner_ids_continue():
 
 def test_scene_deck_continues_a_restart_with_the_scenes_model_and_dt(tmp_path):
     # the README's restart route: the scene's own deck, which carries its model and dt
-    scene = scene_module.write(tmp_path / "scene", scene_module.Scene(
+    scene = rundir.write(tmp_path / "scene", scene_module.Scene(
         ICE, 40, 40, v_col=30.0, b_off=0.2, seed=21, model="frictionless", dt_over_tc=0.02,
         dt_reason="dt = 0.02 t_c given for the test"))
     runs = {}
@@ -113,7 +114,7 @@ def test_scene_deck_continues_a_restart_with_the_scenes_model_and_dt(tmp_path):
         subprocess.run([str(BIN / "lmp"), "-in", "in.collision.lmp", "-screen", "none",
                         "-var", "settle", "no", "-var", "every", "1000", *extra], cwd=where,
                        check=True, timeout=300)
-        final = np.loadtxt(where / scene_module.FINAL_DUMP, skiprows=9)
+        final = np.loadtxt(where / rundir.FINAL_DUMP, skiprows=9)
         return final[np.argsort(final[:, 0])]
 
     straight = lmp_in(runs["straight"], "-var", "steps", "4000")
@@ -303,6 +304,47 @@ def test_a_channel_switched_off_across_a_pair_style_swap_is_booked(lmp):
     assert after["total"] == pytest.approx(before["total"], rel=1e-12)
     booked = sum(after[k] - before[k] for k in ("p7", "p8", "p9"))
     assert booked == pytest.approx(held, rel=1e-12)
+
+
+@pytest.mark.parametrize("switch", ["frictionless", "xi_crit 8e-10 sliding off",
+                                    "xi_crit 8e-10 twisting off rolling off"])
+def test_a_channel_switched_off_across_a_restart_is_booked(tmp_path, switch):
+    # the constants the springs were made with go into the restart file with the contacts,
+    # so a deck that reads it and switches a channel off books the springs' energy as the
+    # same switch between two runs does: the conserved total holds to round-off
+    first = start_lammps()
+    try:
+        two_grain_scene(first, 2 * R_GRAIN - S.delta0, coeff_extra="xi_crit 8e-10")
+        first.command("set atom 1 omega 2e6 1e6 3e6")
+        first.command("run 300 post no")
+        before = ledger(first)
+        first.command(f"write_restart {tmp_path}/loaded.restart")
+    finally:
+        first.close()
+    assert before["p2"] > 0 and before["p3"] > 0 and before["p4"] > 0
+    again = start_lammps()
+    try:
+        again.commands_string(f"""
+            read_restart {tmp_path}/loaded.restart
+            comm_modify vel yes
+            pair_coeff * * gamma 0.1 E 7e9 nu 0.25 {switch}
+            neighbor {2 * S.delta_c!r} bin
+            fix integrate all nve/sphere
+            compute p all pair jkr/dt
+            compute erot all erotate/sphere
+            thermo_style custom {ENERGY_THERMO}
+            thermo_modify norm no
+            run 0 post no
+        """)
+        after = ledger(again)
+    finally:
+        again.close()
+    assert after["total"] == pytest.approx(before["total"], rel=1e-12,
+                                           abs=1e-12 * abs(before["pe"]))
+    for slot, ledger_slot in (("p2", "p7"), ("p3", "p8"), ("p4", "p9")):
+        dropped = before[slot] - after[slot]                    # U_s, U_r, U_t that left pe
+        assert after[ledger_slot] - before[ledger_slot] == pytest.approx(dropped, rel=1e-12,
+                                                                         abs=1e-30)
 
 
 def test_replicate_works_before_the_first_run_and_is_refused_after(lmp):

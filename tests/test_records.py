@@ -7,6 +7,8 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+
 BIN = Path(sys.executable).parent
 JKRDT = str(BIN / "jkrdt")
 
@@ -86,3 +88,70 @@ def test_a_run_cut_off_continues_as_the_uninterrupted_one_and_a_finished_one_is_
                              timeout=120)
     assert refused.returncode == 2 and "holds a finished run (settled at step" in refused.stderr
     assert "--force" in refused.stderr and (cut / "outcome.json").stat().st_mtime_ns == kept
+
+
+def wait_for(path: Path, seconds: float = 120.0) -> None:
+    deadline = time.time() + seconds
+    while not path.exists() and time.time() < deadline:
+        time.sleep(0.02)
+    assert path.exists(), f"{path} never appeared"
+
+
+@pytest.mark.parametrize("how", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
+def test_stopping_a_campaign_stops_its_lammps_at_once(tmp_path, how):
+    # a campaign runs LAMMPS in its own process: any of the three signals ends it within
+    # seconds (SIGINT too: not only when the current chunk returns to Python), and the run
+    # under way is recorded as cut off, to be resumed
+    import json
+
+    from jkrdt import rundir
+    from jkrdt.campaign import run_directory
+
+    spec = tmp_path / "spec.json"
+    spec.write_text(json.dumps(dict(n_tar=64, n_pro=64, v_col=[20.0], b_off2=[0.25], seeds=[2],
+                                    settle=dict(check_tc=5, cap_tc=4000))))
+    run = run_directory(tmp_path / "c", 20.0, 0.25, 2)
+    proc = subprocess.Popen([JKRDT, "campaign", str(spec), str(tmp_path / "c"), "--quiet"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    wait_for(run / "restart.b")
+    proc.send_signal(how)
+    t0 = time.time()
+    _, err = proc.communicate(timeout=20)
+    assert time.time() - t0 < 5 and proc.returncode == -how, (proc.returncode, err)
+    assert "Traceback" not in err
+    size = (run / rundir.LOG).stat().st_size
+    time.sleep(1.0)
+    assert (run / rundir.LOG).stat().st_size == size      # no LAMMPS left writing
+    assert rundir.run_status(run).stop_reason == "cut off"
+    assert not rundir.finished(run)
+
+
+SESSION_SCRIPT = """
+import sys
+from jkrdt.session import Session
+from jkrdt.stopping import SettleRule
+with Session(sys.argv[1], every=1, settle=SettleRule(check_tc=5)) as run:
+    run.run(50_000_000, chunk=200, progress=False)
+"""
+
+
+def test_stopping_a_session_script_leaves_its_record_cut_off(tmp_path):
+    # Python stops a Session script at SIGINT when its current chunk returns: the session
+    # then closes without its end part, so the record says cut off
+    from jkrdt import rundir
+
+    d = tmp_path / "scene"
+    subprocess.run([JKRDT, "setup", "--n-tar", "64", "--n-pro", "64", "--v", "20", "--out",
+                    str(d)], check=True, capture_output=True, timeout=300)
+    script = tmp_path / "script.py"
+    script.write_text(SESSION_SCRIPT)
+    proc = subprocess.Popen([sys.executable, str(script), str(d)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    wait_for(d / "restart.b")
+    proc.send_signal(signal.SIGINT)
+    t0 = time.time()
+    _, err = proc.communicate(timeout=20)
+    assert time.time() - t0 < 5 and proc.returncode != 0 and "KeyboardInterrupt" in err
+    status = rundir.run_status(d)
+    assert status.stop_reason == "cut off" and rundir.FINISH_LINE in status.problem
+    assert not (d / rundir.FINAL_RESTART).exists()

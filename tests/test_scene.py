@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from jkrdt import ledger
-from jkrdt import scene as scene_module
+from jkrdt import rundir
 from jkrdt.materials import ICE, QUARTZ, material
 from jkrdt.scene import Scene, pair_coeff
 
@@ -36,19 +36,19 @@ def test_pair_coeff_is_one_translation_of_material_and_model():
 def test_a_written_scene_reads_back_and_holds_its_impact_energy(tmp_path):
     scene = Scene(ICE, 40, 24, v_col=25.0, b_off=0.4, seed=3, dim=3, model="frictionless",
                   dt_over_tc=0.01, dt_reason="a test's dt")
-    scene_module.write(tmp_path, scene)
-    back = scene_module.read(tmp_path)
+    rundir.write(tmp_path, scene)
+    back = rundir.read(tmp_path)
     assert back == scene
     # E_imp = mu v^2 / 2 is the kinetic energy of the data file's velocities (CM frame)
-    rows = (tmp_path / scene_module.DATA).read_text().split("Velocities")[1].split()
+    rows = (tmp_path / rundir.DATA).read_text().split("Velocities")[1].split()
     v = np.array(rows, dtype=float).reshape(-1, 7)[:, 1:4]
     s = scene.scales
     assert 0.5 * s.mass * (v ** 2).sum() == pytest.approx(scene.E_imp, rel=1e-12)
     assert np.abs(v.sum(axis=0)).max() < 1e-12 * 25.0
-    deck = (tmp_path / scene_module.DECK).read_text()
+    deck = (tmp_path / rundir.DECK).read_text()
     assert f'variable coeffs     index "{pair_coeff(ICE, "frictionless")}"' in deck
     assert f'variable dt         index "{0.01 * s.t_c!r}"' in deck
-    assert deck.endswith(scene_module.find_template().read_text())
+    assert deck.endswith(rundir.find_template().read_text())
 
 
 def test_committed_scene_decks_are_what_the_scene_module_writes(tmp_path):
@@ -56,15 +56,15 @@ def test_committed_scene_decks_are_what_the_scene_module_writes(tmp_path):
         committed = ROOT / "inputs" / "data" / name
         copy = tmp_path / name
         copy.mkdir()
-        (copy / scene_module.META).write_text((committed / scene_module.META).read_text())
-        scene_module.write_deck(copy)
-        assert (copy / scene_module.DECK).read_text() == \
-            (committed / scene_module.DECK).read_text(), \
-            f"regenerate with jkrdt.scene.write_deck('inputs/data/{name}')"
+        (copy / rundir.META).write_text((committed / rundir.META).read_text())
+        rundir.write_deck(copy)
+        assert (copy / rundir.DECK).read_text() == \
+            (committed / rundir.DECK).read_text(), \
+            f"regenerate with jkrdt.rundir.write_deck('inputs/data/{name}')"
 
 
 def test_the_template_carries_the_ledger_and_refuses_to_run_without_a_scene(tmp_path):
-    template = scene_module.find_template().read_text()
+    template = rundir.find_template().read_text()
     assert ledger.THERMO_STYLE in template.splitlines()
     done = subprocess.run([str(BIN / "lmp"), "-in", str(ROOT / "inputs" / "collision.lmp"),
                            "-log", "none"], capture_output=True, text=True, cwd=tmp_path)
@@ -76,8 +76,8 @@ def test_the_template_carries_the_ledger_and_refuses_to_run_without_a_scene(tmp_
 
 def test_jkrdt_run_runs_the_scenes_own_deck(tmp_path):
     scene = Scene(ICE, 8, 8, v_col=5.0, seed=2, model="frictional")
-    scene_module.write(tmp_path, scene)
-    deck = tmp_path / scene_module.DECK
+    rundir.write(tmp_path, scene)
+    deck = tmp_path / rundir.DECK
     # an edit to the scene's deck is what runs: here its pair_coeff words
     deck.write_text(deck.read_text().replace(pair_coeff(ICE), pair_coeff(ICE, "frictionless")))
     subprocess.run([str(BIN / "jkrdt"), "run", str(tmp_path), "--steps", "200"], check=True,
@@ -97,16 +97,16 @@ def test_the_skin_follows_the_scene_so_10_micron_grains_run_as_set_up(tmp_path):
                        capture_output=True, timeout=120)
         ran[name] = subprocess.run([str(BIN / "jkrdt"), "run", str(d), "--steps", "3000"],
                                    capture_output=True, text=True, timeout=300)
-    meta = scene_module.read_metadata(tmp_path / "chosen")
-    t_c = scene_module.from_metadata(meta).scales.t_c
+    meta = rundir.read_metadata(tmp_path / "chosen")
+    t_c = rundir.from_metadata(meta).scales.t_c
     assert meta["skin"] == pytest.approx(8 * 20.0 * 0.014 * t_c, rel=1e-12)
     assert meta["skin"] == pytest.approx(1.32e-7, rel=0.01)
     assert ran["chosen"].returncode == 0, ran["chosen"].stderr
     assert ran["given"].returncode != 0 and "raise the skin above" in ran["given"].stderr
 
 
-CORE = ["aggregates", "collision", "datafile", "ledger", "materials", "plugin", "scene",
-        "session", "stopping", "timestep"]
+CORE = ["aggregates", "atomic", "collision", "datafile", "instance", "ledger", "materials",
+        "plugin", "rundir", "scene", "session", "stopping", "timestep"]
 
 
 def imported(path: Path) -> set[str]:
@@ -132,3 +132,19 @@ def test_the_packages_depend_one_way():
     for path in (ROOT / "analysis").glob("*.py"):
         uses = imported(path)
         assert not uses & {"jkrdt.cli", "jkrdt.campaign", "jkrdt.session"}, path.name
+    # the scene is a value: its directory, deck and runs are rundir's and session's
+    assert not imported(ROOT / "pylammps" / "jkrdt" / "scene.py") & {
+        "jkrdt.rundir", "jkrdt.session", "jkrdt.instance"}
+
+
+def test_no_two_modules_import_each_other_in_a_circle():
+    modules = {f"jkrdt.{p.stem}": p for p in (ROOT / "pylammps" / "jkrdt").glob("*.py")}
+    modules |= {f"jkrdt.analysis.{p.stem}": p for p in (ROOT / "analysis").glob("*.py")}
+    graph = {name: {u for u in imported(path) if u in modules and u != name}
+             for name, path in modules.items()}
+
+    def reaches(start, goal, seen):
+        return any(n == goal or (n not in seen and reaches(n, goal, seen | {n}))
+                   for n in graph[start])
+    circles = sorted(name for name in graph if reaches(name, name, {name}))
+    assert not circles, f"modules in an import circle: {circles}"

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from jkrdt import scene as scene_module
+from jkrdt import rundir
 from jkrdt.analysis.dumps import open_text
 from jkrdt.session import Session
 
@@ -42,19 +42,19 @@ def test_chunks_sample_the_energy_budget(serial):
 
 def test_dumps_and_restarts_on_request(serial):
     out, _, _ = serial
-    with open_text(out / scene_module.ATOMS) as f:
+    with open_text(out / rundir.ATOMS) as f:
         steps = [int(block.split()[0]) for block in f.read().split("ITEM: TIMESTEP\n")[1:]]
     assert steps == [0, 500, 1000, 1500, 2000]
     # a session that closes after no error ends its record as the deck does: final.restart
     # replaces the rolling restart files
     assert (out / "final.restart").exists() and not (out / "restart.a").exists()
-    assert (out / scene_module.CONTACTS).exists()
+    assert (out / rundir.CONTACTS).exists()
 
 
 def test_no_outputs_unless_asked(tmp_path):
     with Session(SCENE, tmp_path) as session:
         session.run(10, progress=False)
-    assert not (tmp_path / scene_module.ATOMS).exists() and not (tmp_path / "restart.a").exists()
+    assert not (tmp_path / rundir.ATOMS).exists() and not (tmp_path / "restart.a").exists()
 
 
 def test_continuing_from_a_restart_repeats_the_run(serial, tmp_path):
@@ -65,6 +65,18 @@ def test_continuing_from_a_restart_repeats_the_run(serial, tmp_path):
     # same contacts, same state: the second half again, to round-off
     assert np.abs(resumed["total"] - energies["total"][4:]).max() < 1e-12 * E_IMP
     assert np.abs(resumed["dissipated"] - energies["dissipated"][4:]).max() < 1e-12 * E_IMP
+
+
+def test_a_session_keeps_a_finished_record(serial):
+    # a session may not start a new record over a finished run's, nor continue from a
+    # restart file over any record without appending to it
+    out = serial[0]
+    log = (out / rundir.LOG).read_text()
+    with pytest.raises(ValueError, match="holds a finished run .* force=True"):
+        Session(SCENE, out, every=500)
+    with pytest.raises(ValueError, match="would replace it; give append=True"):
+        Session(SCENE, out, restart=out / "half.restart")
+    assert (out / rundir.LOG).read_text() == log
 
 
 @pytest.mark.mpi

@@ -15,12 +15,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from jkrdt import rundir
+
 from jkrdt import scene as scene_module
 from jkrdt.analysis.summary import summarise
 from jkrdt.analysis.dumps import frames
 from jkrdt.analysis.fragments import from_contacts
 from jkrdt.analysis.run import RunNotComplete, analyse_run
-from jkrdt.analysis.status import SETTLE_LINE
+from jkrdt.rundir import SETTLE_LINE
 from jkrdt.materials import ICE, scales
 from jkrdt.session import Session
 from jkrdt.stopping import SettleRule
@@ -34,7 +36,7 @@ RULE = SettleRule(check_tc=20, window=5, tolerance=0.01, cap_tc=6000)
 
 def write_scene(directory, v=10.0, seed=3, n=32, skin=None):
     scene = scene_module.Scene(ICE, n, n, v_col=v, seed=seed, kind="bcca", dim=2, skin=skin)
-    return scene_module.write(directory, scene)
+    return rundir.write(directory, scene)
 
 
 def settle_line(log):
@@ -143,7 +145,7 @@ def test_cut_off_run_is_refused_unless_partial(settled, tmp_path):
     d, *_ = settled
     cut = tmp_path / "cut"
     cut.mkdir()
-    for name in ("collision.json", scene_module.ATOMS, scene_module.CONTACTS):
+    for name in ("collision.json", rundir.ATOMS, rundir.CONTACTS):
         (cut / name).write_bytes((d / name).read_bytes())
     # the log of a process killed in mid-run: it ends inside a thermo block
     log = (d / "log.lammps").read_text().splitlines()
@@ -177,12 +179,12 @@ def test_two_ranks_find_the_fragments_the_analysis_finds(tmp_path):
     assert sizes.max() == int(fields["N_lar"]) and len(sizes) == int(fields["fragments"])
 
 
-@pytest.mark.parametrize("cut", [scene_module.ATOMS, scene_module.CONTACTS])
+@pytest.mark.parametrize("cut", [rundir.ATOMS, rundir.CONTACTS])
 def test_truncated_dump_is_refused_unless_partial(settled, tmp_path, cut):
     d, *_ = settled
     run = tmp_path / "run"
     run.mkdir()
-    for name in ("collision.json", "log.lammps", scene_module.ATOMS, scene_module.CONTACTS):
+    for name in ("collision.json", "log.lammps", rundir.ATOMS, rundir.CONTACTS):
         (run / name).write_bytes((d / name).read_bytes())
     data = (run / cut).read_bytes()
     (run / cut).write_bytes(data[: int(0.97 * len(data))])   # killed while writing

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from jkrdt import timestep
-from jkrdt.analysis.thermo import read_thermo
+from jkrdt.rundir import read_thermo
 from jkrdt.ledger import energy_budget
 from jkrdt.materials import ICE, scales
 
@@ -52,3 +52,34 @@ def test_auto_dt_meets_its_tolerance_on_a_collision(tmp_path):
     error = abs(budget["total"] - budget["total"][0]).max() / meta["E_imp"]
     assert error <= 1e-4
     assert math.isfinite(error)
+
+
+@pytest.mark.parametrize("damped", [False, True])
+def test_the_frictionless_bound_lies_above_every_run_it_was_fitted_to(damped):
+    # benchmarks/timestep_frictionless.py: the worst run at each size (dt = 0.014 t_c,
+    # every speed and seed), and the 2 x 50000 run brought to that dt
+    bound = timestep.frictionless_bound(damped)
+    for point in bound["points"]:
+        at = timestep.predicted_error(0.014, 1.0, model="frictionless",
+                                      n_total=point["n_total"], damped=damped)
+        assert point["error_at_dt_0_014"] <= at * (1 + 1e-9), point
+    assert bound["s"] >= 0                      # no smaller error promised for larger N
+
+
+def test_auto_dt_meets_its_tolerance_on_a_frictionless_collision(tmp_path):
+    # the frictionless model's error hardly falls with v_col: at 10 m/s the tradeoff fit's
+    # dt (0.034 t_c at 1e-4) gave 9.7e-4 on this scene, its own bound 7.9e-5 (dt 0.008 t_c)
+    scene = tmp_path / "scene"
+    subprocess.run([str(BIN / "jkrdt"), "setup", "--n-tar", "32", "--n-pro", "32", "--v", "10",
+                    "--seed", "3", "--model", "frictionless", "--dt", "auto", "--tolerance",
+                    "1e-4", "--out", str(scene)], check=True, timeout=120, capture_output=True)
+    meta = json.loads((scene / "collision.json").read_text())
+    dt, _ = timestep.choose(1e-4, 10.0, V0, model="frictionless", n_total=64)
+    assert meta["dt_over_tc"] == pytest.approx(dt, rel=1e-12)
+    assert dt < timestep.choose(1e-4, 10.0, V0)[0] / 3
+    assert "frictionless bound" in meta["dt_reason"]
+    subprocess.run([str(BIN / "jkrdt"), "run", str(scene), "--check", "20", "--cap", "4000"],
+                   check=True, timeout=600, capture_output=True)
+    budget = energy_budget(read_thermo(scene / "log.lammps"))
+    error = abs(budget["total"] - budget["total"][0]).max() / meta["E_imp"]
+    assert error <= 1e-4

@@ -40,6 +40,7 @@ import numpy as np
 from common import run_campaigns, save
 from jkrdt.analysis.summary import b_off_average, cumulative_on, summarise, threshold_velocity
 from jkrdt.analysis.tables import write_csv
+from jkrdt import rundir
 
 HERE = Path(__file__).resolve().parent
 #: the paper's four models: (model, T_vis) and its v_fra at 10^5 grains, m/s
@@ -74,7 +75,7 @@ def model_curve(where: Path, n_total: int) -> dict:
     """<f_gro>(v_col), v_fra and <N_cum> of one model's campaign (``jkrdt summarise``)."""
     summary = summarise(where, plot=False)
     table = sorted(summary["table"], key=lambda r: r["v_col"])
-    outcomes = [json.loads(p.read_text()) for p in sorted(where.rglob("outcome.json"))]
+    outcomes = [json.loads(p.read_text()) for p in sorted(where.rglob(rundir.OUTCOME))]
     complete = [o for o in outcomes if o.get("stop_reason") in ("settled", "steps")]
     grid = np.arange(1, n_total + 1)
     cumulative = {}

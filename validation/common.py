@@ -14,7 +14,7 @@ BIN = Path(sys.executable).parent
 
 def loop_seconds(run: Path) -> float:
     """The wall time LAMMPS spent in the runs of a run directory (its log's 'Loop time')."""
-    from jkrdt.scene import LOG
+    from jkrdt.rundir import LOG
 
     return sum(float(m.group(1)) for m in
                re.finditer(r"Loop time of ([0-9.eE+-]+)", (run / LOG).read_text()))

@@ -35,7 +35,8 @@ import numpy as np
 from common import campaign_paths, loop_seconds, run_campaigns
 from jkrdt.analysis import dumps, fragments
 from jkrdt.analysis.tables import read_csv, write_csv
-from jkrdt.scene import CONTACTS, LOG, META
+from jkrdt import rundir
+from jkrdt.rundir import CONTACTS, LOG, META
 
 HERE = Path(__file__).resolve().parent
 FULL = dict(n=1000, seeds=list(range(1, 9)), v_col=[20.0, 39.8, 100.0],
@@ -69,7 +70,7 @@ def wrong_departures(run: Path) -> tuple[int, int]:
 
 def rows_of(where: Path, model: str, depart: str) -> list[dict]:
     rows = []
-    for path in sorted(where.rglob("outcome.json")):
+    for path in sorted(where.rglob(rundir.OUTCOME)):
         o = json.loads(path.read_text())
         if o.get("stop_reason") not in ("settled", "steps"):
             continue

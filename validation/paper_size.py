@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from common import loop_seconds
-from jkrdt import scene as scene_module
+from jkrdt import rundir
 from jkrdt.analysis.tables import read_csv
 
 HERE = Path(__file__).resolve().parent
@@ -45,7 +45,7 @@ SCENES = {
     "sticking": dict(model="frictional", v=20.0),
 }
 #: what is copied from a run into the results
-KEPT = ("outcome.json", "frames.csv", scene_module.CHECKS, "outcome.png", "timeline.png",
+KEPT = (rundir.OUTCOME, rundir.FRAMES, rundir.CHECKS, "outcome.png", "timeline.png",
         "energy.png")
 
 
@@ -84,7 +84,7 @@ def output_sizes(run: Path) -> dict:
     return dict(files_mb={k: round(v / 2 ** 20, 3) for k, v in written.items()},
                 total_mb=round(sum(written.values()) / 2 ** 20, 1),
                 run_record_mb=round(sum(v for k, v in written.items()
-                                        if k not in (scene_module.DATA,)) / 2 ** 20, 1))
+                                        if k not in (rundir.DATA,)) / 2 ** 20, 1))
 
 
 def per_check(table: Path) -> dict:
@@ -118,7 +118,7 @@ def study(name: str, n: int, ranks: int, runs: Path, results: Path,
     if "run" not in state:
         state["run"] = timed([BIN / "jkrdt", "run", run, "--np", ranks], run / "stage.run",
                              limit=limit)
-        state["run"]["lammps_memory_per_rank_mb"] = lammps_memory(run / scene_module.LOG)
+        state["run"]["lammps_memory_per_rank_mb"] = lammps_memory(run / rundir.LOG)
         state["run"]["ranks"] = ranks
         save()
     if "analyse" not in state:
@@ -126,10 +126,10 @@ def study(name: str, n: int, ranks: int, runs: Path, results: Path,
         state["analyse"] = timed([BIN / "jkrdt", "analyse", run, *partial],
                                  run / "stage.analyse")
         save()
-    out = json.loads((run / "outcome.json").read_text())
+    out = rundir.read_outcome(run)
     state["outputs"] = output_sizes(run)
     state["scene"] = dict(n_tar=n, n_pro=n, **scene, b_off=0.0, seed=1,
-                          dt_over_tc=json.loads((run / scene_module.META).read_text())
+                          dt_over_tc=json.loads((run / rundir.META).read_text())
                           .get("dt_over_tc"))
     state["outcome"] = {k: out.get(k) for k in (
         "stop_reason", "stop_step", "time_end_over_tc", "n_largest", "n_second",
@@ -137,7 +137,7 @@ def study(name: str, n: int, ranks: int, runs: Path, results: Path,
         "contacts_per_particle", "kinetic_left", "kinetic_departed", "energy_error",
         "dissipated_fraction")}
     state["run"]["loop_seconds"] = loop_seconds(run)
-    state["run"]["per_check"] = per_check(run / scene_module.CHECKS)
+    state["run"]["per_check"] = per_check(run / rundir.CHECKS)
     save()
     target = results / name
     target.mkdir(parents=True, exist_ok=True)

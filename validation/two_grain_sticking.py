@@ -33,7 +33,7 @@ import time
 from pathlib import Path
 
 from common import save
-from jkrdt import ledger, scene as scene_module
+from jkrdt import ledger, rundir, scene as scene_module
 from jkrdt.materials import ICE, material, scales
 from jkrdt.session import Session
 from jkrdt.stopping import SettleRule
@@ -61,7 +61,7 @@ def sticks(v_col: float, tvis: float, where: Path) -> bool:
     scene = scene_module.Scene(material("ice", tvis=tvis), 1, 1, v_col=v_col, b_off=0.0,
                                seed=1, model="frictionless", radius=RADIUS,
                                dt_over_tc=DT_OVER_TC, dt_reason="two grains: the tests' step")
-    scene_module.write(where, scene, scene.collide(scene.aggregates()))
+    rundir.write(where, scene, scene.collide(scene.aggregates()))
     with Session(where, settle=SettleRule()) as run:
         run.run_until_settled(progress=False)
         if run.stop_reason != "settled":

@@ -42,6 +42,7 @@ import numpy as np
 
 from common import run_campaigns, save as save_figure
 from jkrdt.analysis.tables import write_csv
+from jkrdt import rundir
 
 HERE = Path(__file__).resolve().parent
 #: Table 3 of the paper: (material preset, xi_crit)
@@ -89,7 +90,7 @@ def collect(plan: dict, runs: Path) -> list[dict]:
     for name in plan["sets"]:
         preset, xi = SETS[name]
         s = scales(material(preset, xi_crit=xi), 1.0e-7)
-        for path in sorted((runs / name.replace(" ", "_")).rglob("outcome.json")):
+        for path in sorted((runs / name.replace(" ", "_")).rglob(rundir.OUTCOME)):
             o = json.loads(path.read_text())
             if o.get("stop_reason") == "error":
                 rows.append(dict(set=name, seed=o["seed"], v_over_v0=o["v_col"] / s.v0,

@@ -20,7 +20,7 @@ left out for the defaults, or given in part), or, with ``"settle": false``, afte
 (``retry_failed``).
 
 Each run goes to ``CAMPAIGN/v<v_col>/b2_<B_off^2>/seed<seed>`` as a scene directory
-(``jkrdt.scene``). Target and projectile are built once per seed and shared by all
+(``jkrdt.rundir``). Target and projectile are built once per seed and shared by all
 v_col and B_off, as in the 3D BPCA paper.
 
 Under ``mpirun -np N jkrdt campaign ... --ranks-per-run K`` the ranks form N/K groups;
@@ -35,29 +35,26 @@ jkr/dt that ran them. A campaign started on it with another spec is refused with
 difference named, unless ``fresh`` (``--fresh``) deletes its runs first. A failed run
 stays failed until ``retry_failed`` (``--retry-failed``) runs it again from the start.
 
-A run is finished when its ``outcome.json`` exists; that file is written last,
-atomically, and is never replaced. A run that was cut off (no outcome.json, but a
-restart file) resumes from its newer whole restart file: its dumps and log are cut back
-to that step and appended to, and the settle rule's window comes back with the restart
-file, so the run ends as the uninterrupted one would have.
+A run is finished when its ``outcome.json`` exists (``jkrdt.rundir``, which also says
+how a cut-off run is continued); that file is written last, atomically, and is never
+replaced. A run that was cut off resumes from its newer whole restart file, its record cut
+back to that step and appended to; the settle rule's window comes back with the restart
+file, so the run ends as the uninterrupted one would have. SIGINT, SIGTERM and SIGHUP end
+``jkrdt campaign`` at once, its run under way left cut off for the next campaign.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import fcntl
-import gzip
 import json
-import os
 import shutil
-import socket
 import time
 from pathlib import Path
 
 import numpy as np
 
 from . import __version__
-from . import scene as scene_module
+from . import rundir
 from .aggregates import BUILDERS
 from .materials import material
 from .scene import Scene
@@ -114,7 +111,13 @@ def check_types(path, spec: dict) -> None:
 def read_spec(path) -> dict:
     """The spec at ``path`` with defaults filled in; ``spec["settle"]`` becomes a
     ``SettleRule`` or None (fixed steps)."""
-    given = json.loads(Path(path).read_text())
+    try:
+        given = json.loads(Path(path).read_text())
+    except json.JSONDecodeError as err:
+        raise ValueError(f"{path} is not valid JSON: {err}; fix the spec there") from None
+    if not isinstance(given, dict):
+        raise ValueError(f"{path}: a campaign spec is a JSON object of keys, e.g. "
+                         '{"n_tar": 128, "n_pro": 128, "v_col": [20], "b_off2": [0]}')
     unknown = sorted(set(given) - set(DEFAULTS) - set(REQUIRED))
     if unknown:
         raise ValueError(f"{path}: unknown keys {unknown}; known: "
@@ -145,6 +148,11 @@ def read_spec(path) -> dict:
         except TypeError:
             raise ValueError(f"{path}: settle takes {sorted(SettleRule.__dataclass_fields__)} "
                              f"(got {sorted(settle)})") from None
+        except ValueError as err:
+            raise ValueError(f"{path}: {err}") from None
+    for v in spec["v_col"]:             # the scenes' own checks, before any run starts
+        try:
+            scene_of(spec, v, spec["b_off2"][0], spec["seeds"][0])
         except ValueError as err:
             raise ValueError(f"{path}: {err}") from None
     return spec
@@ -184,8 +192,6 @@ def drop_runs(campaign: Path) -> None:
 def own(campaign: Path, spec: dict, fresh: bool = False) -> None:
     """Make ``campaign`` the directory of ``spec``: record it there, or raise naming how the
     spec it holds differs; ``fresh`` deletes the runs it holds first."""
-    from jkrdt.analysis.tables import write_json
-
     path = campaign / SPEC_RECORD
     want = spec_record(spec)
     versions = [__version__]
@@ -203,14 +209,14 @@ def own(campaign: Path, spec: dict, fresh: bool = False) -> None:
                              "another directory, or --fresh to delete its runs and start "
                              "afresh")
         versions = sorted(set(had.get("versions", [])) | {__version__})
-    elif any(campaign.glob("v*/b2_*/seed*/outcome.json")) and not fresh:
+    elif any(campaign.glob(f"v*/b2_*/seed*/{rundir.OUTCOME}")) and not fresh:
         raise ValueError(f"{campaign} holds runs but no {SPEC_RECORD}, so their spec is "
                          "unknown: give another directory, or --fresh to delete its runs and "
                          "start afresh")
     elif fresh:
         drop_runs(campaign)
     campaign.mkdir(parents=True, exist_ok=True)
-    write_json(path, dict(spec=want, versions=versions))
+    rundir.write_json(path, dict(spec=want, versions=versions))
 
 
 def retry(todo) -> int:
@@ -218,25 +224,10 @@ def retry(todo) -> int:
     returns how many."""
     cleared = 0
     for *_, directory in todo:
-        outcome = directory / "outcome.json"
-        if outcome.exists() and json.loads(outcome.read_text()).get("stop_reason") == "error":
-            for name in scene_module.SCENE_FILES:
-                (directory / name).unlink(missing_ok=True)
+        if rundir.failed(directory):
+            rundir.clear(directory)
             cleared += 1
     return cleared
-
-
-def record_failure(directory: Path, seed, error: str) -> None:
-    """outcome.json of a run that failed: its parameters and the error, no outcome."""
-    from jkrdt.analysis.tables import write_json
-
-    meta = scene_module.read_metadata(directory)
-    mat = meta["material"]
-    write_json(directory / "outcome.json",
-               dict(run=str(directory), v_col=meta["v_col"], B_off=meta["B_off"], seed=seed,
-                    model=meta.get("model"), material=mat["name"], xi_crit=mat["xi_crit"],
-                    tvis=mat["tvis"], N_tar=meta["N_tar"], N_pro=meta["N_pro"],
-                    stop_reason="error", settled=False, problem=error))
 
 
 def run_directory(campaign, v: float, b2: float, seed) -> Path:
@@ -257,122 +248,23 @@ def scene_of(spec: dict, v: float, b2: float, seed: int) -> Scene:
                  dt_reason=f"dt = {spec['dt']:g} t_c, the campaign's")
 
 
-def claim(directory: Path):
-    """An open, locked ``directory/.claim``, or None if another process holds the run or
-    it has finished. Closing the file (or the holder's death) releases the claim."""
-    directory.mkdir(parents=True, exist_ok=True)
-    f = open(directory / ".claim", "a+")
-    try:
-        fcntl.lockf(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
-        f.close()
-        return None
-    if (directory / "outcome.json").exists():        # finished while we looked
-        f.close()
-        return None
-    f.truncate(0)
-    f.write(f"{socket.gethostname()} pid {os.getpid()} since {time.ctime()}\n")
-    f.flush()
-    return f
-
-
-def resume_point(directory: Path):
-    """(restart file, its step) to continue a cut-off run from, or None: the newer restart
-    file that LAMMPS reads whole (a file cut off while being written is passed over)."""
-    from mpi4py import MPI
-
-    from .session import start_lammps
-
-    if not (directory / "collision.json").exists():
-        return None
-    rolling = (directory / name for name in scene_module.ROLLING_RESTARTS)
-    found = sorted((p for p in rolling if p.exists()), key=lambda p: p.stat().st_mtime,
-                   reverse=True)
-    for path in found:
-        lmp = start_lammps(MPI.COMM_SELF)
-        try:
-            lmp.command(f"read_restart {path}")
-            return path, int(lmp.extract_global("ntimestep"))
-        except Exception:
-            continue
-        finally:
-            lmp.close()
-    return None
-
-
-def cut_dump(path: Path, step: int) -> None:
-    """Keep the snapshots of a dump (plain or compressed) before ``step`` (the resumed run
-    writes ``step`` again); a compressed stream cut off by a kill ends where it was cut."""
-    if not path.exists():
-        return
-    opener = gzip.open if path.suffix == ".gz" else open
-    kept = path.with_name(path.name + ".cut")
-    with opener(path, "rb") as src, opener(kept, "wb") as dst:
-        try:
-            for line in src:
-                if line.startswith(b"ITEM: TIMESTEP"):
-                    at = src.readline()
-                    if int(at) >= step:
-                        break
-                    line += at
-                dst.write(line)
-        except EOFError:
-            pass
-    kept.replace(path)
-
-
-def cut_table(path: Path, step: int) -> None:
-    """Keep the rows of the settle rule's table up to ``step`` (its check at ``step`` came
-    before the restart file; the resumed run writes the checks after it)."""
-    if not path.exists():
-        return
-    lines = path.read_text(errors="replace").splitlines(keepends=True)
-    keep = [line for line in lines[1:] if line.split(",")[0].isdigit()
-            and int(line.split(",")[0]) <= step and line.endswith("\n")]
-    path.write_text("".join(lines[:1] + keep))
-
-
-def cut_log(path: Path, step: int) -> None:
-    """Keep a log up to its thermo row of ``step`` (the resumed run appends from there)."""
-    if not path.exists():
-        return
-    lines = path.read_text(errors="replace").splitlines(keepends=True)
-    last = 0
-    for k, line in enumerate(lines):
-        words = line.split()
-        if words and words[0].isdigit() and int(words[0]) <= step and len(words) > 3:
-            last = k + 1
-    path.write_text("".join(lines[:last]))
-
-
-def cut_back(directory: Path, step: int) -> None:
-    """A cut-off run's record cut back to ``step`` (its restart file's), to be appended to."""
-    for name in (scene_module.ATOMS, scene_module.CONTACTS):
-        cut_dump(directory / name, step)
-    cut_table(directory / scene_module.CHECKS, step)
-    cut_log(directory / scene_module.LOG, step)
-
-
 def prepare(directory: Path, scene: Scene, aggregates: dict):
     """Make ``directory`` ready to run (on the group's leader): "ended" if its run ended
     and only its analysis is missing; (restart file, step) to resume from, the outputs
     cut back to that step; or None after writing the scene afresh."""
-    from jkrdt.analysis.status import run_status
-
-    ended = (directory / scene_module.FINAL_RESTART).exists()
-    if ended and (directory / scene_module.META).exists():
-        status = run_status(directory)
+    ended = (directory / rundir.FINAL_RESTART).exists()
+    if ended and (directory / rundir.META).exists():
+        status = rundir.run_status(directory)
         if status.problem is None and status.stop_reason != "error":
             return "ended"
-    point = resume_point(directory)
+    point = rundir.resume_point(directory)
     if point is not None:
-        cut_back(directory, point[1])
+        rundir.cut_back(directory, point[1])
         return point
-    for name in scene_module.SCENE_FILES:
-        (directory / name).unlink(missing_ok=True)
+    rundir.clear(directory)
     if scene.seed not in aggregates:
         aggregates[scene.seed] = scene.aggregates()
-    scene_module.write(directory, scene, scene.collide(aggregates[scene.seed]))
+    rundir.write(directory, scene, scene.collide(aggregates[scene.seed]))
     return None
 
 
@@ -384,7 +276,7 @@ def run_one(spec: dict, directory: Path, resume, comm) -> str | None:
     restart, start = resume if resume is not None else (None, 0)
     remaining = None
     if resume is not None and spec["settle"] is not None:      # the uninterrupted run's cap
-        ratio = scene_module.read(directory).time_step()[0]
+        ratio = rundir.read(directory).time_step()[0]
         remaining = dict(steps=spec["settle"].cap_steps(ratio) - start)
     try:
         with Session(directory, directory, every=spec["every"] or 1, comm=comm,
@@ -400,7 +292,7 @@ def run_one(spec: dict, directory: Path, resume, comm) -> str | None:
     return None
 
 
-def finish(directory: Path, seed, failed: str | None) -> str:
+def finish(directory: Path, failed: str | None) -> str:
     """Write the run's outcome.json, its analysis or its failure; returns a summary line."""
     from jkrdt.analysis.run import analyse_run    # here: MDAnalysis slows every jkrdt start
 
@@ -411,7 +303,7 @@ def finish(directory: Path, seed, failed: str | None) -> str:
                     f"f_gro {out['growth_efficiency']:+.3f}")
         except ValueError as err:        # the run's outputs do not add up: recorded
             failed = f"analysis: {err}"
-    record_failure(directory, seed, failed)
+    rundir.record_failure(directory, failed)
     return f"FAILED: {failed} (jkrdt campaign ... --retry-failed runs it again)"
 
 
@@ -445,13 +337,13 @@ def run_campaign(spec_path, campaign, progress: bool = True, ranks_per_run: int 
     refused = world.bcast(refused)
     if refused is not None:
         raise ValueError(refused)
-    skipped = sum((d / "outcome.json").exists() for *_, d in todo)
+    skipped = sum(rundir.finished(d) for *_, d in todo)
     world.Barrier()              # every rank has counted before any run finishes
     aggregates, ran = {}, 0
     for v, b2, seed, directory in todo:
         held = None
-        if leader and not (directory / "outcome.json").exists():
-            held = claim(directory)
+        if leader and not rundir.finished(directory):
+            held = rundir.claim(directory)
         if not group.bcast(held is not None):
             continue
         t0 = time.time()
@@ -460,7 +352,7 @@ def run_campaign(spec_path, campaign, progress: bool = True, ranks_per_run: int 
         resume = group.bcast(resume)
         failed = None if resume == "ended" else run_one(spec, directory, resume, group)
         if leader:
-            said = finish(directory, seed, failed)
+            said = finish(directory, failed)
             held.close()
             ran += 1
             how = ("" if resume is None else " (its run had ended; analysed)"
@@ -471,6 +363,5 @@ def run_campaign(spec_path, campaign, progress: bool = True, ranks_per_run: int 
         group.Barrier()
     group.Free()
     ran = world.allreduce(ran if leader else 0)
-    failed = [str(d) for *_, d in todo if (d / "outcome.json").exists()
-              and json.loads((d / "outcome.json").read_text()).get("stop_reason") == "error"]
+    failed = [str(d) for *_, d in todo if rundir.failed(d)]
     return dict(runs=len(todo), skipped=skipped, ran=ran, failed=failed)

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import os
 import re
 import signal
@@ -27,8 +26,10 @@ import numpy as np
 
 from . import campaign as campaign_module
 from . import ledger, timestep
+from . import rundir
 from . import scene as scene_module
 from .aggregates import BUILDERS, bonds, check_fits, gyration_radius
+from .atomic import write_json
 from .datafile import write_sphere_data
 from .materials import PRESETS, material, scales
 from .scene import Scene
@@ -38,7 +39,7 @@ from .stopping import DEFAULT_RULE, ENERGY_WARN, STOP_WORDS, SettleRule
 def run_lammps(deck: Path, out: Path, variables: dict, nproc: int = 1) -> None:
     """Run ``deck`` in ``out``; a continued run (``append`` yes) appends to the log."""
     lmp = Path(sys.executable).parent / "lmp"
-    log = "none" if variables.get("append") == "yes" else str(out / scene_module.LOG)
+    log = "none" if variables.get("append") == "yes" else str(out / rundir.LOG)
     cmd = [str(lmp), "-in", str(deck), "-log", log, "-screen", "none"]
     for k, v in variables.items():
         cmd += ["-var", k, str(v)]
@@ -46,11 +47,8 @@ def run_lammps(deck: Path, out: Path, variables: dict, nproc: int = 1) -> None:
         cmd = [str(Path(sys.executable).parent / "mpirun"), "-np", str(nproc)] + cmd
     returncode = run_stoppable(cmd, out)
     if returncode != 0:
-        log_path = out / scene_module.LOG
-        log = log_path.read_text().splitlines() if log_path.exists() else []
-        errors = [line.strip() for line in log if "ERROR" in line] or [
-            f"exit status {returncode}"]
-        raise SystemExit(f"jkrdt: LAMMPS stopped: {errors[-1]} (full log: {log_path})")
+        error = rundir.run_status(out).error or f"exit status {returncode}"
+        raise SystemExit(f"jkrdt: LAMMPS stopped: {error} (full log: {out / rundir.LOG})")
 
 
 #: the signals that stop jkrdt run, and its LAMMPS with it
@@ -132,11 +130,17 @@ def build(args) -> int:
     meta = dict(kind=args.kind, dimension=args.dim, N=args.n, seed=args.seed, radius=args.radius,
                 material=dataclasses.asdict(mat), r_g=gyration_radius(x),
                 n_bonds=len(bonds(x, args.radius, s.delta0)), build_seconds=built)
-    (out / "aggregate.json").write_text(json.dumps(meta, indent=2))
+    write_json(out / "aggregate.json", meta)
     print(f"{args.kind.upper()} of {args.n} grains ({args.dim}D) built in {built:.2f} s: "
           f"r_g = {meta['r_g'] / args.radius:.3f} r, {meta['n_bonds']} bonds; "
           f"wrote {out / 'aggregate.data'} and aggregate.json")
     return 0
+
+
+def bound_of(scene: Scene) -> dict:
+    """What the energy-error bound of ``jkrdt.timestep`` depends on besides dt and v_col."""
+    return dict(model=scene.model, n_total=scene.n_tar + scene.n_pro,
+                damped=scene.material.tvis > 0)
 
 
 def write_scene(scene: Scene, out, tolerance: float | None = None, force: bool = False):
@@ -149,15 +153,16 @@ def write_scene(scene: Scene, out, tolerance: float | None = None, force: bool =
         if not force:
             raise SystemExit(f"jkrdt: {out} is not empty; choose another --out, or give --force "
                              "to replace the scene and run outputs there")
-        for name in scene_module.SCENE_FILES:
-            (out / name).unlink(missing_ok=True)
+        rundir.clear(out)
     if tolerance is not None:
         try:
-            dt, reason = timestep.choose(tolerance, scene.v_col, scene.scales.v0)
+            dt, reason = timestep.choose(tolerance, scene.v_col, scene.scales.v0,
+                                         **bound_of(scene))
         except ValueError as err:
             raise SystemExit(f"jkrdt: {err}") from None
         scene = dataclasses.replace(scene, dt_over_tc=dt, dt_reason=reason)
-        expected = timestep.predicted_error(dt, scene.v_col / scene.scales.v0)
+        expected = timestep.predicted_error(dt, scene.v_col / scene.scales.v0,
+                                            **bound_of(scene))
         if expected > 1.001 * tolerance:
             print(f"jkrdt: WARNING: --dt auto cannot reach --tolerance {tolerance:g} at "
                   f"{scene.v_col:g} m/s: dt is held at {dt:g} t_c, where the fit expects max "
@@ -165,11 +170,11 @@ def write_scene(scene: Scene, out, tolerance: float | None = None, force: bool =
     t0 = time.time()
     placed = scene.collide()
     built = time.time() - t0
-    scene_module.write(out, scene, placed, build_seconds=built)
+    rundir.write(out, scene, placed, build_seconds=built)
     print(f"{scene.kind.upper()} {scene.n_tar} + {scene.n_pro} ({scene.dim}D, "
           f"{scene.material.name}, {scene.model}) built in {built:.1f} s; E_imp = "
-          f"{scene.E_imp:.3e} J; wrote {out / scene_module.DATA}, {scene_module.META} and "
-          f"{scene_module.DECK}\n{scene.time_step()[1]}")
+          f"{scene.E_imp:.3e} J; wrote {out / rundir.DATA}, {rundir.META} and "
+          f"{rundir.DECK}\n{scene.time_step()[1]}")
     return scene
 
 
@@ -180,41 +185,33 @@ def run_scene(out: Path, dt: float | None, steps: int | None, nproc: int,
     overrides the scene's time step. A run that was cut off continues from its newer
     restart file, adding to its record; a finished run is refused unless ``force``, which
     runs it again from the start."""
-    from jkrdt.analysis.status import run_status
-    from jkrdt.analysis.thermo import read_thermo
-
-    scene = scene_module.read(out)
-    deck = scene_module.deck(out)
-    variables = dict(out=".", **(scene.time_variables(dt) if dt is not None else {}))
+    scene = rundir.read(out)
+    deck = rundir.deck(out)
+    variables = dict(out=".", **(rundir.time_variables(scene, dt) if dt is not None else {}))
     ratio = scene.time_step(dt)[0]
     if steps is None:
         variables.update(rule.deck_variables(ratio))
     else:
-        variables.update(settle="no", steps=steps, every=output_interval(steps))
-    before = run_status(out) if (out / scene_module.LOG).exists() else None
+        variables.update(rundir.fixed_steps(steps, output_interval(steps)))
+    before = rundir.run_status(out) if (out / rundir.LOG).exists() else None
     resume = None
     if before is not None and before.problem is None and not force:
         raise SystemExit(f"jkrdt: {out} holds a finished run ({STOP_WORDS[before.stop_reason]} "
                          f"at step {before.stop_step}); --force runs it again from the start, "
                          "replacing its record")
     if before is not None and before.stop_reason == "cut off" and not force:
-        resume = campaign_module.resume_point(out)
+        resume = rundir.resume_point(out)
     if resume is not None:
         restart, start = resume
-        campaign_module.cut_back(out, start)
-        for stale in scene_module.ANALYSIS_OUTPUTS:     # of an earlier --partial analysis
-            (out / stale).unlink(missing_ok=True)
-        variables.update(read="read_restart", file=restart.name, append="yes",
-                         steps=int(variables["steps"]) - start)
+        rundir.cut_back(out, start)
+        variables.update(rundir.continuation(restart.name, int(variables["steps"]) - start))
         print(f"continuing the run that was cut off, from {restart.name} at step {start}")
     else:
-        for stale in scene_module.SCENE_FILES:
-            if stale not in (scene_module.DATA, scene_module.META, scene_module.DECK):
-                (out / stale).unlink(missing_ok=True)
+        rundir.clear_run(out)
     t0 = time.time()
     run_lammps(deck, out, variables, nproc=nproc)
-    status = run_status(out)
-    error = ledger.energy_error(ledger.energy_budget(read_thermo(out / scene_module.LOG)),
+    status = rundir.run_status(out)
+    error = ledger.energy_error(ledger.energy_budget(rundir.read_thermo(out / rundir.LOG)),
                                 scene.E_imp)
     print(f"{STOP_WORDS[status.stop_reason]} at step {status.stop_step} of at most "
           f"{variables['steps']} ({scene.model}, dt = {ratio:g} t_c) in {time.time() - t0:.1f} s "
@@ -335,6 +332,12 @@ def campaign(args) -> int:
     from .campaign import run_campaign
 
     from mpi4py import MPI
+
+    # the campaign's LAMMPS runs in this process: each of STOPPING ends it at once (SIGINT
+    # too, not when the current chunk returns to Python; SIGHUP even where the parent
+    # ignored it), leaving the run under way cut off for the next campaign to resume
+    for how in STOPPING:
+        signal.signal(how, signal.SIG_DFL)
 
     done = run_campaign(args.spec, args.dir, progress=not args.quiet,
                         ranks_per_run=args.ranks_per_run, fresh=args.fresh,

@@ -36,7 +36,7 @@ def set_up(target: np.ndarray, projectile: np.ndarray, radius: float, v_col: flo
 
     Both are rotated at random, centred on their centres of mass, and the
     projectile is slid along x until its nearest grain is ``gap`` (default
-    delta_c / 2) outside contact with the target. ``jkrdt.scene`` writes the result.
+    delta_c / 2) outside contact with the target. ``jkrdt.rundir`` writes the result.
     """
     if not 0.0 <= b_off <= 1.0:
         raise ValueError("B_off must lie in [0, 1]")

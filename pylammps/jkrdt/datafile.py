@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
+
+from .atomic import write_atomic
 
 
 def _num(*values) -> str:
@@ -51,9 +51,5 @@ def write_sphere_data(path, x, radius, density, v=None, omega=None, types=None,
     lines += [f"{i + 1} {types[i]} {_num(2 * radius[i], density[i], *x[i])}" for i in range(n)]
     lines += ["", "Velocities", ""]
     lines += [f"{i + 1} {_num(*v[i], *omega[i])}" for i in range(n)]
-    path = Path(path)
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text("\n".join(lines) + "\n")
-    tmp.replace(path)
-    return path
+    return write_atomic(path, "\n".join(lines) + "\n")
 

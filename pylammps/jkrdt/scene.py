@@ -1,16 +1,11 @@
-"""A collision scene: what it is, how it is written into a directory and read back, and
-the ``pair_coeff`` line of its material and model. Every other part (``jkrdt setup``,
-``jkrdt run``, campaigns, ``Session``, the analysis) goes through this module.
+"""A collision scene: what it is, and the ``pair_coeff`` line of its material and model.
 
 A scene is the material and grain radius, the dimension, the model ('frictional':
 Wada et al. 2007 with the material's xi_crit; 'frictionless': the 3D BPCA paper's
 model without sliding, rolling and twisting), the aggregates' kind and sizes, v_col,
-B_off, the seed and the time step. Its directory holds
-
-    collision.data     the grains (target type 1, projectile type 2), LAMMPS data file
-    collision.json     the scene's fields and its set-up (E_imp, b, gap, ...)
-    in.collision.lmp   its variables, then ``inputs/collision.lmp``: the deck every
-                       route runs (``cd DIR && lmp -in in.collision.lmp``)
+B_off, the seed, the time step and the neighbor skin. It is a value: how it is written
+into a directory, read back and run (``collision.json``, the deck and its variables) is
+``jkrdt.rundir``'s.
 
 E_imp = mu v_col^2 / 2 with mu = m N_tar N_pro / (N_tar + N_pro), equal grains of mass m.
 """
@@ -19,43 +14,16 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import json
-from pathlib import Path
 
 import numpy as np
 
 from . import collision
 from . import timestep
 from .aggregates import BUILDERS, check_fits
-from .datafile import write_sphere_data
-from .materials import Material, from_dict, scales
+from .materials import Material, scales
 from .timestep import PAPER_DT
 
 MODELS = ("frictional", "frictionless")
-#: up to this many grains a scene finds neighbors without bins (``neighbor nsq``) and does
-#: not sort its atoms: LAMMPS's bins and sort bins fill the whole box, which fragments
-#: flying apart make huge (2 x 100 frictionless grains at 39.8 m/s: 83 s with bins,
-#: 3.6 s without); for a compact scene of 1000 grains both cost the same
-NSQ_MAX = 2000
-DATA, META, DECK = "collision.data", "collision.json", "in.collision.lmp"
-#: a run's record (inputs/collision.lmp writes them): the frames of atoms and of contacts
-#: (compressed, every ``frames`` checks and at the end), the settle rule's table of the
-#: fragments at every check, and the log with the energies at every check
-ATOMS, CONTACTS, CHECKS, LOG = "atoms.dump.gz", "contacts.dump.gz", "checks.csv", "log.lammps"
-#: the outputs a new run of a scene replaces; LAMMPS appends to none of them, but a run
-#: that fails early would leave the last run's behind
-RUN_OUTPUTS = (ATOMS, CONTACTS, CHECKS, LOG)
-#: the end state (written at the end of a run: the restart file, and the grains with their
-#: spins, compressed) and the restart files of a run under way, written alternately at
-#: every check
-FINAL_RESTART, FINAL_DUMP = "final.restart", "final.dump.gz"
-ROLLING_RESTARTS = ("restart.a", "restart.b")
-#: what a scene directory holds once set up, run and analysed (all that a fresh scene clears)
-#: what jkrdt analyse writes into a run directory
-ANALYSIS_OUTPUTS = ("frames.csv", "outcome.json", "outcome.png", "outcome.pdf", "energy.png",
-                    "energy.pdf", "timeline.png", "timeline.pdf")
-SCENE_FILES = (DATA, META, DECK, *RUN_OUTPUTS, *ANALYSIS_OUTPUTS, *ROLLING_RESTARTS,
-               FINAL_RESTART, FINAL_DUMP)
 
 
 def pair_coeff(mat: Material, model: str = "frictional") -> str:
@@ -148,24 +116,12 @@ class Scene:
             return self.dt_over_tc, self.dt_reason or "the scene's dt"
         return PAPER_DT, f"dt = {PAPER_DT} t_c, the papers' choice (Wada et al. 2007, sec. 4)"
 
-    def time_variables(self, dt_over_tc: float | None = None) -> dict:
-        """The deck's dt (s), dt_over_tc and dt_note for ``dt_over_tc`` (see time_step)."""
-        ratio, why = self.time_step(dt_over_tc)
-        return dict(dt=ratio * self.scales.t_c, dt_over_tc=ratio,
-                    dt_note=why.replace('"', "'"), skin=self.skin_for(ratio))
-
     def skin_for(self, dt_over_tc: float) -> float:
         """The neighbor skin (m): the scene's own, else SKIN_MIN or, for grains that move
         farther in a step (large grains, fast collisions), SKIN_STEPS steps at 2 v_col."""
         if self.skin is not None:
             return self.skin
         return max(SKIN_MIN, SKIN_STEPS * 2.0 * self.v_col * dt_over_tc * self.scales.t_c)
-
-    def deck_variables(self) -> dict:
-        """The variables of ``inputs/collision.lmp`` that make it run this scene."""
-        few = self.n_tar + self.n_pro <= NSQ_MAX
-        return dict(file=DATA, dim=self.dim, coeffs=self.pair_coeff, **self.time_variables(),
-                    **(dict(neighbor="nsq", sort="0 0.0") if few else {}))
 
     def aggregates(self, rng=None) -> tuple[np.ndarray, np.ndarray]:
         """Target and projectile built by ``rng`` (default: a generator seeded by the
@@ -188,93 +144,3 @@ class Scene:
             raise ValueError("the aggregates do not have the scene's n_tar and n_pro grains")
         return collision.set_up(*aggregates, self.radius, v_col=self.v_col, b_off=self.b_off,
                                 rng=rng, delta_c=self.scales.delta_c, dim=self.dim)
-
-    def metadata(self) -> dict:
-        """``collision.json`` without the set-up's geometry."""
-        meta = dict(N_tar=self.n_tar, N_pro=self.n_pro, v_col=self.v_col, B_off=self.b_off,
-                    seed=self.seed, material=dataclasses.asdict(self.material),
-                    radius=self.radius, dimension=self.dim, E_imp=self.E_imp, kind=self.kind,
-                    model=self.model)
-        if self.dt_over_tc is not None:
-            meta.update(dt_over_tc=self.dt_over_tc, dt_reason=self.dt_reason)
-        meta.update(skin=self.skin_for(self.time_step()[0]), skin_given=self.skin is not None)
-        return meta
-
-
-def from_metadata(meta: dict) -> Scene:
-    """The scene of a ``collision.json``."""
-    return Scene(material=from_dict(meta["material"]), n_tar=meta["N_tar"],
-                 n_pro=meta["N_pro"], v_col=meta["v_col"], b_off=meta["B_off"],
-                 seed=meta.get("seed"), kind=meta.get("kind") or "bpca",
-                 dim=meta["dimension"], radius=meta["radius"],
-                 model=meta.get("model") or "frictional", dt_over_tc=meta.get("dt_over_tc"),
-                 dt_reason=meta.get("dt_reason"),
-                 skin=meta["skin"] if meta.get("skin_given") else None)
-
-
-def read_metadata(directory) -> dict:
-    path = Path(directory) / META
-    if not path.exists():
-        raise FileNotFoundError(f"{path} does not exist: {directory} is not a scene; write one "
-                                "with 'jkrdt setup' (or jkrdt.scene.write)")
-    return json.loads(path.read_text())
-
-
-def read(directory) -> Scene:
-    """The scene written into ``directory``."""
-    return from_metadata(read_metadata(directory))
-
-
-def find_template(name: str = "collision.lmp") -> Path:
-    """A deck of ``inputs/``: the copy installed in the package, else the checkout's."""
-    here = Path(__file__).resolve().parent
-    for base in [here, Path.cwd(), *here.parents]:
-        deck = base / "inputs" / name
-        if deck.exists():
-            return deck
-    raise FileNotFoundError(f"inputs/{name} not found: reinstall with 'pip install .' "
-                            "or run from the repository root")
-
-
-def deck(directory) -> Path:
-    """The scene's own deck in ``directory``; raises with the fix if it is missing."""
-    path = Path(directory) / DECK
-    if not path.exists():
-        raise FileNotFoundError(f"{path} does not exist: write the scene with 'jkrdt setup', "
-                                f"or its deck with jkrdt.scene.write_deck('{directory}')")
-    return path
-
-
-def write_deck(directory, scene: Scene | None = None) -> Path:
-    """``in.collision.lmp``: the scene's variables, then ``inputs/collision.lmp`` verbatim
-    (a variable's first definition wins, so ``-var NAME VALUE`` still overrides)."""
-    directory = Path(directory)
-    scene = read(directory) if scene is None else scene
-    lines = ["# jkr/dt: the scene in this directory (written by jkr/dt's scene module); run",
-             "#   lmp -in in.collision.lmp     or     mpirun -np 2 lmp -in in.collision.lmp",
-             "# here. Any variable below can be overridden with -var NAME VALUE.", ""]
-    lines += [f'variable {name:<10} index "{value}"'
-              for name, value in scene.deck_variables().items()]
-    deck = directory / DECK
-    tmp = deck.with_name(DECK + ".tmp")
-    tmp.write_text("\n".join(lines) + "\n\n" + find_template().read_text())
-    tmp.replace(deck)
-    return deck
-
-
-def write(directory, scene: Scene, placed: collision.Collision | None = None,
-          **extra) -> Path:
-    """Write the scene into ``directory``: its grains (``placed``, default
-    ``scene.collide()``), ``collision.json`` (with ``extra`` fields) and its deck.
-    Returns the directory."""
-    directory = Path(directory)
-    directory.mkdir(parents=True, exist_ok=True)
-    placed = scene.collide() if placed is None else placed
-    write_sphere_data(directory / DATA, placed.x, scene.radius, scene.material.density,
-                      v=placed.v, types=placed.body, margin=20 * scene.radius)
-    meta = dict(scene.metadata(), **placed.meta, **extra)
-    tmp = directory / (META + ".tmp")
-    tmp.write_text(json.dumps(meta, indent=2, default=float))
-    tmp.replace(directory / META)
-    write_deck(directory, scene)
-    return directory

