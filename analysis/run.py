@@ -193,8 +193,8 @@ def summary_text(out: dict) -> str:
     if "potential_change" in out:
         lines.append(f"energy partition / E_imp    kinetic {out['kinetic_left']:.3f} + potential "
                      f"change {out['potential_change']:+.3f} + dissipated "
-                     f"{out['dissipated_fraction']:.3f} - drift {out['energy_drift']:+.1e} = "
-                     f"{out['kinetic_start']:.3f}, the kinetic energy at the start")
+                     f"{out['dissipated_fraction']:.3f} = {out['kinetic_start']:.3f} (kinetic "
+                     f"at the start) {out['energy_drift']:+.1e} (drift)")
         lines.append(f"max |dE| / E_imp            {out['energy_error']:.2e}"
                      + (f"  WARNING: above {ENERGY_WARN:g}; use a smaller --dt"
                         if out["energy_warning"] else ""))

@@ -3,6 +3,7 @@ that conserve ke + erotate + pe + dissipated, continues from its restarts, and r
 the same collision under mpirun -np 2 with mpi4py."""
 
 import json
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -77,6 +78,15 @@ def test_a_session_keeps_a_finished_record(serial):
     with pytest.raises(ValueError, match="would replace it; give append=True"):
         Session(SCENE, out, restart=out / "half.restart")
     assert (out / rundir.LOG).read_text() == log
+
+
+def test_a_new_record_leaves_no_stale_analysis(serial, tmp_path):
+    shutil.copytree(serial[0], tmp_path / "copy")
+    out = tmp_path / "copy"
+    (out / rundir.OUTCOME).write_text('{"stop_reason": "settled"}')
+    with Session(SCENE, out, force=True) as session:
+        session.run(10, progress=False)
+    assert not (out / rundir.OUTCOME).exists()
 
 
 @pytest.mark.mpi

@@ -73,6 +73,8 @@ class Session:
         self.meta = rundir.read_metadata(scene)
         self.scene = rundir.from_metadata(self.meta)
         self._keep_record(restart, append, force)
+        if self.comm.rank == 0:          # an analysis of an earlier record is stale now
+            rundir.clear(self.out, rundir.ANALYSIS_OUTPUTS)
         deck = rundir.deck(scene)
         self.deck = deck
         self.settle = settle
