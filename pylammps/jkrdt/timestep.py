@@ -44,48 +44,45 @@ def frictionless_bound(damped: bool) -> dict:
     return fit()["frictionless"]["damped" if damped else "undamped"]
 
 
+def bounds(v_over_v0: float, model: str = "frictional", n_total: int | None = None,
+           damped: bool = False) -> list[tuple[float, float, str]]:
+    """The bounds that hold for a scene, each as (log10 of its prefactor at this scene,
+    its exponent of dt / t_c, where it comes from): max |dE| / E_imp <= 10^a (dt/t_c)^p."""
+    f = fit()
+    out = [(f["log10_C"] + f["q"] * math.log10(v_over_v0), f["p"],
+            f"the fit {10 ** f['log10_C']:.3g} (dt/t_c)^{f['p']:.2f} (v/v0)^{f['q']:.2f} of "
+            "benchmarks/tradeoff")]
+    if model == "frictionless":
+        if n_total is None or n_total < 2:
+            raise ValueError("the frictionless model's bound needs the scene's grain count")
+        b = frictionless_bound(damped)
+        out.append((b["log10_C"] + b["s"] * math.log10(n_total / b["n_ref"]), b["p"],
+                    f"the {'damped ' if damped else ''}frictionless bound "
+                    f"{10 ** b['log10_C']:.3g} (dt/t_c)^{b['p']:.2f} (N/{b['n_ref']})^"
+                    f"{b['s']:.2f} at N = {n_total} of benchmarks/timestep_frictionless"))
+    return out
+
+
 def predicted_error(dt_over_tc: float, v_over_v0: float, model: str = "frictional",
                     n_total: int | None = None, damped: bool = False) -> float:
     """The bound on max |dE| / E_imp at ``dt_over_tc``: the tradeoff fit, and for the
     frictionless model the larger of it and the frictionless bound at ``n_total`` grains."""
-    f = fit()
-    error = 10 ** (f["log10_C"] + f["p"] * math.log10(dt_over_tc)
-                   + f["q"] * math.log10(v_over_v0))
-    if model == "frictionless":
-        b = frictionless_bound(damped)
-        error = max(error, 10 ** (b["log10_C"] + b["p"] * math.log10(dt_over_tc)
-                                  + b["s"] * math.log10(_n(n_total) / b["n_ref"])))
-    return error
-
-
-def _n(n_total: int | None) -> int:
-    if n_total is None or n_total < 2:
-        raise ValueError("the frictionless model's bound needs the scene's grain count")
-    return n_total
+    return max(10 ** (a + p * math.log10(dt_over_tc))
+               for a, p, _ in bounds(v_over_v0, model, n_total, damped))
 
 
 def choose(tolerance: float, v_col: float, v0: float, model: str = "frictional",
            n_total: int | None = None, damped: bool = False) -> tuple[float, str]:
     """(dt / t_c, the reason) for a max |dE| / E_imp of ``tolerance`` at ``v_col`` under
-    ``model`` (for 'frictionless', of ``n_total`` grains, ``damped`` or not)."""
+    ``model`` (for 'frictionless', of ``n_total`` grains, ``damped`` or not): the largest
+    dt that every bound of the scene allows."""
     if not 0 < tolerance < 1:
         raise ValueError(f"--tolerance is a relative energy error in (0, 1) (got {tolerance})")
     if not v_col > 0:
         raise ValueError(f"the impact speed must be > 0 to choose dt (got {v_col})")
-    f = fit()
     v = v_col / v0
-    dt = 10 ** ((math.log10(tolerance) - f["log10_C"] - f["q"] * math.log10(v)) / f["p"])
-    why = (f"the fit {10 ** f['log10_C']:.3g} (dt/t_c)^{f['p']:.2f} (v/v0)^{f['q']:.2f} of "
-           "benchmarks/tradeoff")
-    if model == "frictionless":
-        b = frictionless_bound(damped)
-        size = (_n(n_total) / b["n_ref"]) ** b["s"]
-        free = 10 ** ((math.log10(tolerance) - b["log10_C"] - math.log10(size)) / b["p"])
-        if free < dt:
-            dt = free
-            why = (f"the {'damped ' if damped else ''}frictionless bound "
-                   f"{10 ** b['log10_C']:.3g} (dt/t_c)^{b['p']:.2f} (N/{b['n_ref']})^"
-                   f"{b['s']:.2f} at N = {n_total} of benchmarks/timestep_frictionless")
+    dt, why = min((10 ** ((math.log10(tolerance) - a) / p), why)
+                  for a, p, why in bounds(v, model, n_total, damped))
     held = min(max(dt, DT_MIN), DT_MAX)
     reason = (f"dt = {held:.4g} t_c chosen for max |dE|/E_imp <= {tolerance:g} at v_col = "
               f"{v_col:g} m/s = {v:.3g} v0 from {why}")
