@@ -126,7 +126,7 @@ def main(argv=None):
         for rep in range(args.repeat):
             for name, (path, sort) in variants.items():
                 deck = bench_pair.DECK.format(data=path, pair=bench_pair.JKRDT_FULL,
-                                              steps=steps, dt=dt)
+                                              steps=steps, dt=dt, skin=1.0e-8)
                 deck = deck.replace("read_data", f"{sort}\nread_data") if sort else deck
                 run = bench_pair.per_atom_step(bench_pair.timed_run(deck, tmp, 1, 1),
                                                natoms, steps)

@@ -13,7 +13,11 @@ Styles, each on the same data file, dt = 0.014 t_c:
   granular jkr                    jkr, no tangential history
   (baseline) full / frictionless  the same two with --baseline, an older build of the plugin
 Parallel set-ups: serial (1 rank), mpi2 (mpirun -np 2), omp2 (1 rank, 2 OpenMP threads
-through '-sf omp -pk omp 2', as a LAMMPS user asks for them).
+through '-sf omp -pk omp 2', as a LAMMPS user asks for them); skin20 (1 rank, a 20 nm
+neighbor skin instead of 10 nm: twice the neighbors that are not in contact).
+The physical limit: each (repeat, size) round also times a plain copy (numpy) of
+BYTES_PER_ATOM_STEP bytes per atom, the memory traffic one atom-step needs at the least,
+and reports it per atom-step beside the styles ("plain copy").
 Every (repeat, size) round runs all styles one after another, so the styles are
 interleaved (A B A B) and share the machine's load; the load average is recorded.
 The granular laws differ from Wada et al.'s (k_roll = 12 pi gamma; mu_s = 0.5,
@@ -47,7 +51,7 @@ newton off
 comm_modify vel yes
 read_data {data}
 {pair}
-neighbor 1.0e-8 bin
+neighbor {skin!r} bin
 neigh_modify every 1 delay 0 check yes
 fix integrate all nve/sphere
 thermo {steps}
@@ -67,7 +71,14 @@ STYLES = {
     "granular jkr": "pair_style granular\n" + GRANULAR_JKR + "tangential linear_nohistory 0.0 0.0",
 }
 BASELINE = {"baseline full": JKRDT_FULL, "baseline frictionless": JKRDT_BARE}
-CONFIGS = {"serial": (1, 1), "mpi2": (2, 1), "omp2": (1, 2)}      # (ranks, threads)
+CONFIGS = {"serial": (1, 1), "mpi2": (2, 1), "omp2": (1, 2), "skin20": (1, 1)}  # (ranks, threads)
+SKIN = {"skin20": 2.0e-8}                       # the neighbor skin where it is not 10 nm
+# the least memory traffic of one atom-step, in bytes: the pair loop reads x, v, omega,
+# radius, type, mask (~90) and adds to f and torque (48 read + 48 written); velocity
+# Verlet's two half-steps read and write x, v, omega and read f, torque, rmass, radius
+# (~300); forces are cleared (48); ~1.1 neighbors per atom cost their index (4) and
+# contact slot (a flag and 7 doubles read and written, ~115) each: about 700
+BYTES_PER_ATOM_STEP = 700
 
 
 def scene(n: int, where: Path) -> Path:
@@ -117,6 +128,21 @@ def timed_run(deck: str, workdir: Path, ranks: int, threads: int, plugin=None) -
                 process_seconds=wall, memory_mbytes_per_rank=memory)
 
 
+def plain_copy(natoms: int, repeats: int = 20) -> dict:
+    """The physical limit on this machine now: copying BYTES_PER_ATOM_STEP bytes per atom
+    (numpy, best of ``repeats``), in microseconds per atom-step."""
+    import numpy as np
+
+    src = np.ones(BYTES_PER_ATOM_STEP * natoms // 8)
+    dst = np.empty_like(src)
+    best = float("inf")
+    for _ in range(repeats):
+        start = time.perf_counter()
+        np.copyto(dst, src)
+        best = min(best, time.perf_counter() - start)
+    return dict(loop_us_per_atom_step=best * 1e6 / natoms, bytes_per_atom_step=BYTES_PER_ATOM_STEP)
+
+
 def per_atom_step(run: dict, natoms: int, steps: int) -> dict:
     scale = 1e6 / (natoms * steps)
     return dict(run, loop_us_per_atom_step=run["loop_seconds"] * scale,
@@ -134,6 +160,8 @@ def summarise(results: dict, sizes: list[int], configs: list[str]) -> dict:
         for size in sizes:
             cell = {}
             for ours, peer in (("jkr/dt full", "granular full"),
+                               ("jkr/dt full", "plain copy"),
+                               ("jkr/dt frictionless", "plain copy"),
                                ("jkr/dt frictionless", "granular jkr"),
                                ("jkr/dt full", "baseline full"),
                                ("jkr/dt frictionless", "baseline frictionless")):
@@ -153,7 +181,8 @@ def summarise(results: dict, sizes: list[int], configs: list[str]) -> dict:
         for size in sizes:
             out["efficiency"][f"{config} {size}x2"] = {
                 style: best("serial", size, style) / (ranks * threads * best(config, size, style))
-                for style in results[config][str(size)] if best("serial", size, style)}
+                for style in results[config][str(size)]
+                if style != "plain copy" and best("serial", size, style)}
     return out
 
 
@@ -193,7 +222,8 @@ def main(argv=None):
                     natoms = 2 * n
                     steps = max(10, int(args.atom_steps / natoms))
                     for name, pair in styles.items():
-                        deck = DECK.format(data=data[n], pair=pair, steps=steps, dt=dt)
+                        deck = DECK.format(data=data[n], pair=pair, steps=steps, dt=dt,
+                                           skin=SKIN.get(config, 1.0e-8))
                         plugin = args.baseline if name.startswith("baseline") else None
                         run = per_atom_step(timed_run(deck, tmp, ranks, threads, plugin),
                                             natoms, steps)
@@ -204,6 +234,13 @@ def main(argv=None):
                               f"{run['loop_us_per_atom_step']:.3f} us/atom-step "
                               f"(pair {run['pair_us_per_atom_step']:.3f}), "
                               f"{run['memory_mbytes_per_rank']:.1f} MB/rank", flush=True)
+                    if config == args.configs[0]:
+                        copy = plain_copy(natoms)
+                        for c in args.configs:
+                            results.setdefault(c, {}).setdefault(str(n), {}) \
+                                .setdefault("plain copy", []).append(dict(copy, repeat=rep))
+                        print(f"{natoms:6d} atoms plain copy of {BYTES_PER_ATOM_STEP} B/atom "
+                              f"{copy['loop_us_per_atom_step']:.4f} us/atom-step", flush=True)
                 load.append(os.getloadavg()[0])
     report = dict(
         scene="two equal ice BPCA aggregates (jkrdt setup), 20 m/s, B_off 0.3, dt = 0.014 t_c",

@@ -18,7 +18,7 @@ using namespace LAMMPS_NS;
 
 static PairJKRDT *find_pair(LAMMPS *lmp, const char *style)
 {
-  auto *pair = dynamic_cast<PairJKRDT *>(lmp->force->pair_match("jkr/dt", 1, 0));
+  auto *pair = PairJKRDT::active(lmp);
   if (!pair) lmp->error->all(FLERR, "compute {} requires pair_style jkr/dt", style);
   return pair;
 }

@@ -2,7 +2,6 @@
 
 #include "fix_jkr_dt_contacts.h"
 
-#include "pair_jkr_dt.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -150,7 +149,7 @@ void FixJKRDTContacts::check_atoms(bigint natoms_before)
 
 void FixJKRDTContacts::init()
 {
-  if (force->pair_match("jkr/dt", 1, 0)) return;
+  if (writer.by) return;    // pair jkr/dt is set up for this run
   const bigint stored = count();
   if (stored > 0)
     error->all(FLERR,
@@ -203,8 +202,7 @@ std::vector<double> FixJKRDTContacts::gather(const std::vector<double> &mine, MP
 void FixJKRDTContacts::post_run()
 {
   to_rows();    // between runs the rows are the state
-  auto *pair = dynamic_cast<PairJKRDT *>(force->pair_match("jkr/dt", 1, 0));
-  if (pair) pair->report_run();
+  if (writer.by) writer.on_run_end();
 }
 
 /* ----------------------------------------------------------------------
@@ -266,8 +264,7 @@ int FixJKRDTContacts::setmask()
 void FixJKRDTContacts::pre_exchange()
 {
   to_rows();
-  auto *pair = dynamic_cast<PairJKRDT *>(force->pair_match("jkr/dt", 1, 0));
-  if (pair) pair->fit_bins(neighbor->cutneighmax);
+  if (writer.by) writer.on_exchange();
 }
 
 /* ----------------------------------------------------------------------
@@ -276,8 +273,7 @@ void FixJKRDTContacts::pre_exchange()
 
 void FixJKRDTContacts::post_neighbor()
 {
-  auto *pair = dynamic_cast<PairJKRDT *>(force->pair_match("jkr/dt", 1, 0));
-  if (pair && pair->list) to_slots(pair->list);
+  if (writer.by && writer.list_of_slots()) to_slots(writer.list_of_slots());
 }
 
 bool FixJKRDTContacts::slots_follow(const NeighList *list) const
@@ -291,7 +287,7 @@ bool FixJKRDTContacts::slots_follow(const NeighList *list) const
    contact must be found in the list, or it is named and the run stops
 ------------------------------------------------------------------------- */
 
-void FixJKRDTContacts::to_slots(NeighList *list)
+void FixJKRDTContacts::to_slots(const NeighList *list)
 {
   if (rows_stale)
     error->one(FLERR, "pair jkr/dt: the contact state was not written back before the "
@@ -349,8 +345,7 @@ void FixJKRDTContacts::to_slots(NeighList *list)
                one_sided_ids[0], one_sided_ids[1]);
   for (int i = 0; i < nlocal; i++)
     if (found[i] != npartner[i]) {
-      auto *pair = dynamic_cast<PairJKRDT *>(force->pair_match("jkr/dt", 1, 0));
-      pair->report_lost_contact();    // names the contact and why; does not return
+      writer.on_lost_contact();    // names the contact and why; does not return
     }
   slot_list = list;
   slot_build = neighbor->lastcall;

@@ -18,7 +18,9 @@
    are filled from the rows by partner ID after every neighbor list build
    (post_neighbor), which is also where a contact missing from the new list
    is caught and named.
-   The pair style creates this fix and is the only writer. The fix outlives
+   The pair style creates this fix and is the only writer; it registers
+   itself through the Writer interface below, so this fix includes nothing
+   of the pair style. The fix outlives
    a pair_style command that replaces jkr/dt, and then refuses to run while
    it holds contacts (they would go stale); pair_style jkr/dt takes them back.
 
@@ -44,12 +46,24 @@
 
 #include "jkr_dt_contact.h"
 
+#include <functional>
 #include <vector>
 
 namespace LAMMPS_NS {
 
 class FixJKRDTContacts : public Fix {
  public:
+  // what the store asks of the pair style that writes it, at the store's moments. The pair
+  // style sets these when a run is set up and clears them when it is deleted, so the store
+  // includes and calls nothing of it
+  struct Writer {
+    const void *by = nullptr;                             // the pair style that set them
+    std::function<const class NeighList *()> list_of_slots;  // the list the slots follow
+    std::function<void()> on_exchange;     // atoms are about to migrate (bins, box)
+    std::function<void()> on_run_end;      // the end of a run (its report)
+    std::function<void()> on_lost_contact;    // a stored contact left the list: say why, stop
+  } writer;
+
   // per-contact value fields, each present only when its bit is in the layout mask:
   //   DAMPING_FORCE  F_D of eq. (A.5) at the last step          (tvis > 0)
   //   POINTERS       contact pointers n1, n2, section 2.2.4      (sliding or rolling)
@@ -94,7 +108,7 @@ class FixJKRDTContacts : public Fix {
 
   // list-order state: slot s of the pair loop (running over ilist, then each
   // atom's neighbors) is bonded if bonded[s], with values slot_values + s * dnum
-  void to_slots(class NeighList *list);
+  void to_slots(const class NeighList *list);
   void to_rows();
   bool slots_follow(const class NeighList *list) const;
   void rows_changed() { rows_stale = true; }

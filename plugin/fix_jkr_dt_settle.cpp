@@ -102,7 +102,7 @@ void FixJKRDTSettle::post_constructor()
 
 void FixJKRDTSettle::init()
 {
-  auto *pair = dynamic_cast<PairJKRDT *>(force->pair_match("jkr/dt", 1, 0));
+  auto *pair = PairJKRDT::active(lmp);
   if (!pair) error->all(FLERR, "fix jkr/dt/settle requires pair_style jkr/dt");
   if (depart == DEPART_NO) return;
   double lightest;
@@ -150,7 +150,7 @@ int FixJKRDTSettle::Graph::root(int k)
 
 FixJKRDTSettle::Partition FixJKRDTSettle::partition(Graph &graph) const
 {
-  auto *pair = dynamic_cast<PairJKRDT *>(force->pair_match("jkr/dt", 1, 0));
+  auto *pair = PairJKRDT::active(lmp);
   const FixJKRDTContacts *C = pair ? pair->contacts() : nullptr;
   std::vector<tagint> mine;
   if (C)

@@ -220,7 +220,7 @@ void FixJKRDTSettle::find_departures(Graph &graph)
   // rank's, grouped by fragment: x, v, r. A grain whose kinetic energy against its
   // fragment's rigid motion is below E_break per contact it holds cannot break them
   // all: it stays bound, inside its fragment's sphere
-  auto *pair = dynamic_cast<PairJKRDT *>(force->pair_match("jkr/dt", 1, 0));
+  auto *pair = PairJKRDT::active(lmp);
   const FixJKRDTContacts *C = pair->contacts();
   std::vector<double> mine_grains;
   for (int i = 0; i < nlocal; i++) {

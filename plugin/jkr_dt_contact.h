@@ -61,7 +61,9 @@ struct Coefficients {
 struct ContactConstants {
   NormalScales S;
   double r1, r2;
+  double radsum;        // r1 + r2: the pair touches at |x1 - x2| = radsum, eq. (3)
   double inv_delta0;    // 1 / delta0
+  double inv_delta_c;   // 1 / delta_c
   double u_unit;        // F_c delta_c, the unit of U_n in eq. (6)
   double damp;          // damp_coef a0: F_D = damp y^2 v_n, eq. (A.5) with a = y^2 a0
   Tangential K;
@@ -74,7 +76,9 @@ inline ContactConstants contact_constants(const Coefficients &P, double r1, doub
   c.S = normal_scales(r1, r2, P.gamma, P.a0_coef);
   c.r1 = r1;
   c.r2 = r2;
+  c.radsum = r1 + r2;
   c.inv_delta0 = 1.0 / c.S.delta0;
+  c.inv_delta_c = 1.0 / c.S.delta_c;
   c.u_unit = c.S.F_c * c.S.delta_c;
   c.damp = P.damp_coef * c.S.a0;
   const double a0 = c.S.a0;
@@ -89,6 +93,19 @@ inline ContactConstants contact_constants(const Coefficients &P, double r1, doub
   c.K.phi_crit = PHI_CRIT;                   // eq. (38)
   c.tangential = P.tangential();
   return c;
+}
+
+// the same numbers in every constant (NaN, a channel's unused limit, equals NaN)
+inline bool same_constants(const ContactConstants &a, const ContactConstants &b)
+{
+  const double x[] = {a.S.R, a.S.a0, a.S.delta0, a.S.delta_c, a.S.F_c, a.r1, a.r2, a.damp,
+                      a.K.k_s, a.K.zeta_crit, a.K.k_r, a.K.xi_crit, a.K.k_t, a.K.phi_crit};
+  const double y[] = {b.S.R, b.S.a0, b.S.delta0, b.S.delta_c, b.S.F_c, b.r1, b.r2, b.damp,
+                      b.K.k_s, b.K.zeta_crit, b.K.k_r, b.K.xi_crit, b.K.k_t, b.K.phi_crit};
+  for (int k = 0; k < 14; k++)
+    if (!(x[k] == y[k] || (std::isnan(x[k]) && std::isnan(y[k])))) return false;
+  return a.K.sliding == b.K.sliding && a.K.rolling == b.K.rolling &&
+      a.K.twisting == b.K.twisting;
 }
 
 // where a contact's stored values sit: offsets into its values, -1 = not stored
@@ -141,6 +158,7 @@ struct ContactResult {
   double U_n;            // eq. (6), when energy was asked for
   double U[NCHANNEL];    // eqs. (11), (21), (25)
   double loss[NLOSS];    // energy dissipated in this step by channel, whole contact
+  bool lossy;            // some loss[] may be non-zero
   bool broken;           // the contact separated in this step
 };
 
@@ -167,7 +185,7 @@ inline double breaking_loss(double delta, double vn, double dt, const NormalScal
 
 inline void tangential_step(const ContactConstants &c, const StateLayout &L,
                             const ContactMotion &m, double dt, bool setup, bool formed,
-                            bool breaking, double *state, ContactResult &out)
+                            bool breaking, bool energy, double *state, ContactResult &out)
 {
   const Tangential &K = c.K;
   const double R = c.S.R;
@@ -179,8 +197,7 @@ inline void tangential_step(const ContactConstants &c, const StateLayout &L,
   if (!traced) {
     now = {-nc, nc, 0.0};    // section 2.2.4: n1(t0) = -n_c(t0), n2 = n_c
   } else if (!setup) {
-    now.n1 = turned(before.n1, dt * m.w1);
-    now.n2 = turned(before.n2, dt * m.w2);
+    turned(now.n1, dt * m.w1, now.n2, dt * m.w2);
     if (K.twisting) {
       // eq. (24): phi += (omega1 - omega2) . n_c dt, n_c at the half step:
       // (d12 - h) / |d12 - h| with h = (v1 - v2) dt/2, to first order in h / r
@@ -191,48 +208,103 @@ inline void tangential_step(const ContactConstants &c, const StateLayout &L,
     }
   }
 
-  ChannelLoad load[NCHANNEL];
+  // a set-up evaluates the stored state as it is: the clamp of eqs. (42), (A8) is exact
+  // to second order only, so clamping again would move a contact the last step left on
+  // its plateau, and a run continued from a restart file would leave the uninterrupted one
+  Displacements d;                                                       // eqs. (8)-(20)
   int clamped = 0;
-  if (breaking) {
-    for (int ch = 0; ch < NCHANNEL; ch++) load[ch] = {0.0, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
-  } else {
-    // a set-up evaluates the stored state as it is: the clamp of eqs. (42), (A8) is exact
-    // to second order only, so clamping again would move a contact the last step left on
-    // its plateau, and a run continued from a restart file would leave the uninterrupted one
-    Displacements d;                                                     // eqs. (8)-(20)
+  if (!breaking) {
     if (setup)
       d = displacements(now, nc, c.r1, c.r2, R);
     else
       clamped = clamp_to_elastic_limits(now, nc, c.r1, c.r2, R, K, d);
-    tangential_load(now, d, nc, m.r, c.r1, c.r2, R, K, load);           // eqs. (14)-(27)
   }
-
-  if (traced && !setup && (breaking || clamped)) {
+  const bool booked = traced && !setup && (breaking || clamped);
+  if (booked) {
+    // a step that clamps or breaks books, per channel, what the loads' work over the step
+    // and the change of the channel's potential leave over (step_dissipation)
+    ChannelLoad load[NCHANNEL], prev[NCHANNEL];
+    if (breaking)
+      for (int ch = 0; ch < NCHANNEL; ch++) load[ch] = {0.0, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    else
+      tangential_load(now, d, nc, m.rinv, c.r1, c.r2, R, K, load);       // eqs. (14)-(27)
     const V3 dx12 = dt * m.v12;
     const V3 dtheta1 = dt * m.w1, dtheta2 = dt * m.w2;
     const V3 d12_before = m.d12 - dx12;
-    const double r_before = norm(d12_before);
-    ChannelLoad prev[NCHANNEL];
-    tangential_load(before, (1.0 / r_before) * d12_before, r_before, c.r1, c.r2, R, K, prev);
+    const double rinv_before = 1.0 / norm(d12_before);
+    tangential_load(before, rinv_before * d12_before, rinv_before, c.r1, c.r2, R, K, prev);
     for (int ch = 0; ch < NCHANNEL; ch++) {
       const double w_before = channel_work(prev[ch], dx12, dtheta1, dtheta2);
       const double w_after = channel_work(load[ch], dx12, dtheta1, dtheta2);
       out.loss[LOSS_SLIDING + ch] += step_dissipation(prev[ch].U, w_before, load[ch].U, w_after);
     }
+    out.lossy = true;
   }
   if (breaking) return;
+  // the loads as every step computes them, so that a set-up reproduces the step's loads
+  // bit for bit
   store_state(state, L, now);
-  for (int ch = 0; ch < NCHANNEL; ch++) {
-    out.F1 = out.F1 + load[ch].F1;
-    out.M1 = out.M1 + load[ch].M1;
-    out.M2 = out.M2 + load[ch].M2;
-    out.U[ch] = load[ch].U;
+  add_tangential_loads(now, d, nc, m.rinv, c.r1, c.r2, R, K, energy, out.F1, out.M1, out.M2,
+                       out.U);                                           // eqs. (14)-(27)
+}
+
+/* ----------------------------------------------------------------------
+   the normal interaction over one step (section 2.1 and eq. A.5): all a
+   contact without tangential channels needs, in a result small enough to
+   stay in registers. delta = r1 + r2 - r, eq. (3); formed: the pair was not
+   bonded before this step (delta >= 0); energy: fill U_n. Reads and writes
+   the stored F_D (state[L.fd]) when damped.
+------------------------------------------------------------------------- */
+
+struct NormalResult {
+  double f;             // force along x1 - x2 (F_1 = f d12 / r): eq. (5) minus F_D of eq. (A.5)
+  double U_n;           // eq. (6), when energy was asked for or the contact formed
+  double loss_event;    // formation or breaking, booked as LOSS_FORM_BREAK
+  double loss_damping;  // the work of F_D over the step, booked as LOSS_DAMPING
+  bool lossy;           // some loss may be non-zero
+  bool broken;          // the contact separated in this step
+};
+
+inline void normal_step(const ContactConstants &c, const StateLayout &L, double vn, double delta,
+                        double dt, bool setup, bool formed, bool energy, double *state,
+                        NormalResult &n)
+{
+  const NormalScales &S = c.S;
+  n.f = n.U_n = n.loss_event = n.loss_damping = 0.0;
+  n.broken = false;
+  n.lossy = !setup && (formed || c.damp > 0.0);
+  if (!formed && delta < -S.delta_c) {
+    // separation (section 2.1): U_n drops to 0 from its value at the last step
+    n.broken = true;
+    if (!setup) {
+      n.lossy = true;
+      n.loss_event = breaking_loss(delta, vn, dt, S);
+      if (c.damp > 0.0) n.loss_damping = 0.5 * dt * state[L.fd] * vn;
+    }
+    return;
+  }
+  const double y = contact_sqrt_radius(delta * c.inv_delta0);    // eq. (4)
+  n.f = S.F_c * normal_force_ratio(y);                             // eq. (5)
+  if (energy || (formed && !setup)) n.U_n = c.u_unit * normal_potential_ratio(y);    // eq. (6)
+  // contact formation (section 2.1): U_n jumps from 0 to U_n(0)
+  if (formed && !setup) n.loss_event = event_loss(0.0, n.U_n, n.f, vn, dt);
+
+  if (c.damp > 0.0) {
+    // eq. (A.5); a run's first evaluation reuses the stored F_D, so that a
+    // continued run equals an uninterrupted one. Its work over the step is the
+    // trapezoid F_D(n) (v_n(n-1/2) + v_n(n+1/2)) dt / 2 of the two half-kicks
+    const double fd_prev = formed ? 0.0 : state[L.fd];
+    const double fd = (setup && !formed) ? fd_prev : c.damp * y * y * vn;
+    if (!setup) n.loss_damping = 0.5 * dt * (fd_prev + fd) * vn;
+    state[L.fd] = fd;
+    n.f -= fd;
   }
 }
 
 /* ----------------------------------------------------------------------
-   one contact over one step. delta = r1 + r2 - r, eq. (3); formed: the
-   pair was not bonded before this step (delta >= 0); energy: fill U_n.
+   one contact over one step: the normal interaction, then the tangential
+   channels. delta = r1 + r2 - r, eq. (3); formed: the pair was not bonded
+   before this step (delta >= 0); energy: fill U_n and U.
    The state (L.dnum values) is read and written in place.
 ------------------------------------------------------------------------- */
 
@@ -240,44 +312,21 @@ inline void contact_step(const ContactConstants &c, const StateLayout &L,
                          const ContactMotion &m, double delta, double dt, bool setup,
                          bool formed, bool energy, double *state, ContactResult &out)
 {
-  const NormalScales &S = c.S;
-  out.F1 = out.M1 = out.M2 = {0.0, 0.0, 0.0};
-  out.U_n = 0.0;
+  out.M1 = out.M2 = {0.0, 0.0, 0.0};
   for (int ch = 0; ch < NCHANNEL; ch++) out.U[ch] = 0.0;
   for (int l = 0; l < NLOSS; l++) out.loss[l] = 0.0;
-  out.broken = false;
-
-  if (!formed && delta < -S.delta_c) {
-    // separation (section 2.1): U_n drops to 0 from its value at the last step
-    out.broken = true;
-    if (!setup) {
-      out.loss[LOSS_FORM_BREAK] = breaking_loss(delta, m.vn, dt, S);
-      if (c.damp > 0.0) out.loss[LOSS_DAMPING] = 0.5 * dt * state[L.fd] * m.vn;
-    }
-    if (c.tangential) tangential_step(c, L, m, dt, setup, false, true, state, out);
-    return;
-  }
   if (formed)
     for (int k = 0; k < L.dnum; k++) state[k] = 0.0;
 
-  const double y = contact_sqrt_radius(delta * c.inv_delta0);    // eq. (4)
-  double fmag = S.F_c * normal_force_ratio(y);                     // eq. (5)
-  if (energy || (formed && !setup)) out.U_n = c.u_unit * normal_potential_ratio(y);    // eq. (6)
-  // contact formation (section 2.1): U_n jumps from 0 to U_n(0)
-  if (formed && !setup) out.loss[LOSS_FORM_BREAK] = event_loss(0.0, out.U_n, fmag, m.vn, dt);
-
-  if (c.damp > 0.0) {
-    // eq. (A.5); a run's first evaluation reuses the stored F_D, so that a
-    // continued run equals an uninterrupted one. Its work over the step is the
-    // trapezoid F_D(n) (v_n(n-1/2) + v_n(n+1/2)) dt / 2 of the two half-kicks
-    const double fd_prev = formed ? 0.0 : state[L.fd];
-    const double fd = (setup && !formed) ? fd_prev : c.damp * y * y * m.vn;
-    if (!setup) out.loss[LOSS_DAMPING] = 0.5 * dt * (fd_prev + fd) * m.vn;
-    state[L.fd] = fd;
-    fmag -= fd;
-  }
-  out.F1 = (fmag * m.rinv) * m.d12;
-  if (c.tangential) tangential_step(c, L, m, dt, setup, formed, false, state, out);
+  NormalResult n;
+  normal_step(c, L, m.vn, delta, dt, setup, formed, energy, state, n);
+  out.U_n = n.U_n;
+  out.loss[LOSS_FORM_BREAK] = n.loss_event;
+  out.loss[LOSS_DAMPING] = n.loss_damping;
+  out.lossy = n.lossy;
+  out.broken = n.broken;
+  out.F1 = n.broken ? V3{0.0, 0.0, 0.0} : (n.f * m.rinv) * m.d12;
+  if (c.tangential) tangential_step(c, L, m, dt, setup, formed, n.broken, energy, state, out);
 }
 
 }    // namespace JKRDT

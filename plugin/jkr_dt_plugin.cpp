@@ -62,7 +62,8 @@ static Compute *create_coordination(LAMMPS *lmp, int narg, char **arg)
   return new ComputeJKRDTCoordination(lmp, narg, arg);
 }
 
-extern "C" void lammpsplugin_init(void *lmp, void *handle, void *regfunc)
+extern "C" __attribute__((visibility("default"))) void lammpsplugin_init(void *lmp, void *handle,
+                                                                void *regfunc)
 {
   auto register_plugin = (lammpsplugin_regfunc) regfunc;
   lammpsplugin_t plugin;

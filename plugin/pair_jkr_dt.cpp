@@ -38,6 +38,7 @@
 #include "comm.h"
 #include "domain.h"
 #include "error.h"
+#include "force.h"
 #include "group.h"
 #include "memory.h"
 #include "modify.h"
@@ -80,13 +81,16 @@ PairJKRDT::PairJKRDT(LAMMPS *lmp) :
 
 PairJKRDT::~PairJKRDT()
 {
+  // looked up, not remembered: the fix may be gone already (unfix, or plugins unloaded)
+  auto *held = modify ? dynamic_cast<Contacts *>(modify->get_fix_by_id(FIX_ID)) : nullptr;
+  if (held && held->writer.by == this) held->writer = Contacts::Writer();
   delete[] pvector;
   if (allocated) {
     memory->destroy(setflag);
     memory->destroy(cutsq);
   }
   // the contact fix outlives the pair style: a pair_style command that replaces jkr/dt
-  // leaves the contacts in place, and the fix refuses a run without jkr/dt while it
+  // leaves the contacts in place (with no writer), and the fix refuses a run without jkr/dt while it
   // holds any (FixJKRDTContacts::init); pair_style jkr/dt given again takes them back
 }
 
@@ -134,6 +138,7 @@ void PairJKRDT::init_style()
   check_data_file_contacts();
   find_contact_time();
   one_radius_per_type = true;
+  any_tangential = false;
   type_constants.assign(param.size(), JKRDT::ContactConstants{});
   for (int i = 1; i <= atom->ntypes; i++)
     for (int j = 1; j <= atom->ntypes; j++) {
@@ -142,6 +147,24 @@ void PairJKRDT::init_style()
         one_radius_per_type = false;
       if (present)
         type_constants[i * nstride + j] = JKRDT::contact_constants(par(i, j), minrad[i], minrad[j]);
+      any_tangential = any_tangential || par(i, j).tangential();
+    }
+  radii_adapt = false;
+  for (const Fix *fix : modify->get_fix_list())
+    radii_adapt = radii_adapt || utils::strmatch(fix->style, "^adapt");
+  radii_checked = -1;
+  // one set of constants for the scene: every type pair present has the same numbers
+  // (the usual two aggregates of one material, given two types)
+  scene_pair = -1;
+  for (int i = 1; i <= atom->ntypes && one_radius_per_type; i++)
+    for (int j = 1; j <= atom->ntypes; j++) {
+      if (!std::isfinite(minrad[i]) || !std::isfinite(minrad[j])) continue;
+      if (scene_pair < 0) scene_pair = i * nstride + j;
+      if (!JKRDT::same_constants(type_constants[i * nstride + j], type_constants[scene_pair])) {
+        scene_pair = -1;
+        i = atom->ntypes;
+        break;
+      }
     }
 
   const int departed = group->find(DEPARTED_GROUP);
@@ -180,6 +203,11 @@ void PairJKRDT::init_style()
   }
   fix_contacts->set_layout(layout_mask());
   fix_contacts->made_with = made_with_record(param);
+  fix_contacts->writer.by = this;
+  fix_contacts->writer.list_of_slots = [this]() -> const NeighList * { return list; };
+  fix_contacts->writer.on_exchange = [this]() { fit_bins(neighbor->cutneighmax); };
+  fix_contacts->writer.on_run_end = [this]() { run_ended(); };
+  fix_contacts->writer.on_lost_contact = [this]() { contact_lost(); };
 }
 
 /* ----------------------------------------------------------------------
@@ -254,14 +282,22 @@ void PairJKRDT::compute(int eflag, int vflag)
     a.thread = t;
     a.thread_of = nthreads > 1 ? thread_of.data() : nullptr;
     a.far.clear();
-    a.upot = a.contacts = a.eng = a.step_max = 0.0;
+    a.upot = a.eng = a.step_max = 0.0;
+    a.contact_ends = 0;
     std::fill(a.utan, a.utan + JKRDT::NCHANNEL, 0.0);
     std::fill(a.virial, a.virial + 6, 0.0);
     a.trouble = Trouble();
   }
 
+  const ConstantsBy by = constants_by();
+  auto loop = [&](int from, int to, bool tally, Accumulator &a) {
+    if (any_tangential)
+      pair_loop<true>(from, to, eflag, tally, by, a);
+    else
+      pair_loop<false>(from, to, eflag, tally, by, a);
+  };
   if (nthreads == 1) {
-    pair_loop(0, inum, eflag, tally_atoms, acc[0]);
+    loop(0, inum, tally_atoms, acc[0]);
   } else {
     if ((int) thread_of.size() < atom->nlocal) thread_of.resize(atom->nmax);
 #if defined(_OPENMP)
@@ -272,7 +308,7 @@ void PairJKRDT::compute(int eflag, int vflag)
       const int to = (int) ((bigint) inum * (t + 1) / nthreads);
       for (int ii = from; ii < to; ii++) thread_of[list->ilist[ii]] = t;
 #pragma omp barrier
-      pair_loop(from, to, eflag, false, acc[t]);
+      loop(from, to, false, acc[t]);
     }
 #endif
     // what each thread added to other threads' atoms, in thread order: the same
@@ -293,7 +329,7 @@ void PairJKRDT::compute(int eflag, int vflag)
     if (acc[t].trouble.kind != Trouble::NONE) report(acc[t].trouble);
     if (t == 0) continue;
     total.upot += acc[t].upot;
-    total.contacts += acc[t].contacts;
+    total.contact_ends += acc[t].contact_ends;
     total.eng += acc[t].eng;
     total.step_max = std::max(total.step_max, acc[t].step_max);
     for (int ch = 0; ch < JKRDT::NCHANNEL; ch++) total.utan[ch] += acc[t].utan[ch];
@@ -306,16 +342,50 @@ void PairJKRDT::compute(int eflag, int vflag)
       for (int k = 0; k < 6; k++) virial[k] += total.virial[k];
   }
   C.rows_changed();
-  if (eflag_global) fill_pvector(total.upot, total.utan, total.contacts);
+  if (eflag_global) fill_pvector(total.upot, total.utan, 0.5 * total.contact_ends);
 }
 
 /* ----------------------------------------------------------------------
-   the pair loop over ilist entries [ii_from, ii_to): each pair in its
-   canonical orientation (p has the smaller ID) through contact_step();
-   half of a contact's dissipation goes to each of its owned atoms
+   where the pair loop finds a contact's constants (contact_constants), as
+   the radii are now: one set for the scene when every type pair present
+   has the same constants and each type one radius, one per type pair when
+   each type has one radius, else from each pair's radii. The radii are
+   checked when the neighbor list is built (atoms arrive, ghosts change),
+   and at every step while a fix adapt, which changes them, is defined.
 ------------------------------------------------------------------------- */
 
-void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, Accumulator &acc)
+PairJKRDT::ConstantsBy PairJKRDT::constants_by()
+{
+  if (!one_radius_per_type) return BY_RADII;
+  if (!radii_adapt && radii_checked == neighbor->lastcall && !update->setupflag)
+    return constants_source;
+  radii_checked = neighbor->lastcall;
+  const double *radius = atom->radius;
+  const int *type = atom->type;
+  const int nall = atom->nlocal + atom->nghost;
+  constants_source = scene_pair >= 0 ? BY_SCENE : BY_TYPE;
+  for (int k = 0; k < nall; k++)
+    if (radius[k] != minrad[type[k]]) constants_source = BY_RADII;
+  return constants_source;
+}
+
+/* ----------------------------------------------------------------------
+   the pair loop over ilist entries [ii_from, ii_to), in five steps per
+   pair: the distance test (all that a pair out of contact costs), the
+   orientation and constants, the motion and its guards, contact_step(),
+   and the loads and dissipation on this thread's owned atoms. TANGENTIAL:
+   some type pair has a tangential channel.
+
+   Orientation. The tangential state is kept for particle 1 = the smaller
+   ID, so a contact with a channel is evaluated in that orientation. The
+   normal force needs no orientation: swapping the atoms negates d12 and
+   v12 exactly and leaves every product the same, so without channels the
+   pair is taken as the list gives it and the same bits result.
+------------------------------------------------------------------------- */
+
+template <bool TANGENTIAL>
+void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, ConstantsBy by,
+                          Accumulator &acc)
 {
   using JKRDT::V3;
   // LAMMPS's per-atom 3-vectors are contiguous: index them flat, one load less per neighbor
@@ -335,10 +405,6 @@ void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, A
   // an owned atom of another thread gets its share through acc.far
   const int *thread_of_atom = acc.thread_of;
   const int me = acc.thread;
-  auto far = [&](int a) -> FarLoad & {
-    acc.far.push_back(FarLoad{a, {0, 0, 0}, {0, 0, 0}, {0, 0, 0, 0, 0}});
-    return acc.far.back();
-  };
 
   Contacts &C = *fix_contacts;
   const JKRDT::StateLayout layout = C.layout();
@@ -348,141 +414,160 @@ void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, A
   const int *numneigh = list->numneigh;
   int **firstneigh = list->firstneigh;
 
-  // the constants depend on the type pair and the radii only: one per type pair when
-  // each type has one radius, else the last ones reused
-  JKRDT::ContactConstants cached{};
-  const JKRDT::ContactConstants *Kp = &cached;
+  const JKRDT::ContactConstants *const scene_K =
+      by == BY_SCENE ? &type_constants[scene_pair] : nullptr;
+  JKRDT::ContactConstants cached{};    // BY_RADII: the last pair's, reused while they fit
   const Param *last_param = nullptr;
   double last_r1 = -1.0, last_r2 = -1.0;
-  const bool by_type = one_radius_per_type;
-  JKRDT::ContactResult out;
-  auto trouble = [&](Trouble::Kind kind, int p, int q, double a, double b) {
-    acc.trouble.kind = kind;
-    acc.trouble.p = p;
-    acc.trouble.q = q;
-    acc.trouble.a = a;
-    acc.trouble.b = b;
-    acc.trouble.S = Kp->S;
+  auto constants = [&](int p, int q) -> const JKRDT::ContactConstants & {
+    if (by == BY_SCENE) return *scene_K;
+    if (by == BY_TYPE) return type_constants[type[p] * nstride + type[q]];
+    const Param &P = par(type[p], type[q]);
+    if (&P != last_param || radius[p] != last_r1 || radius[q] != last_r2) {
+      cached = JKRDT::contact_constants(P, radius[p], radius[q]);
+      last_param = &P;
+      last_r1 = radius[p];
+      last_r2 = radius[q];
+    }
+    return cached;
   };
+  auto trouble = [&](Trouble::Kind kind, int p, int q, double a, double b,
+                     const JKRDT::ContactConstants &K) {
+    if (tag[q] < tag[p]) std::swap(p, q);    // name the pair as the other rank does
+    acc.trouble = {kind, p, q, a, b, K.S};
+  };
+  JKRDT::ContactResult out;
 
   for (int ii = ii_from; ii < ii_to; ii++) {
     const int i = ilist[ii];
     const int *jlist = firstneigh[i];
+    const int jnum = numneigh[i];
+    const V3 xi = JKRDT::vec(x + 3 * i);
     int s = C.slot_first[ii];
-    for (int jj = 0; jj < numneigh[i]; jj++, s++) {
+    for (int jj = 0; jj < jnum; jj++, s++) {
       const int j = jlist[jj] & NEIGHMASK;
 
-      // canonical orientation: p has the smaller ID
-      int p = i, q = j;
-      if (tag[q] < tag[p]) std::swap(p, q);
+      // 1. the distance test
       const bool bonded = bonded_slot[s];
-
-      const V3 d12 = JKRDT::vec(x + 3 * p) - JKRDT::vec(x + 3 * q);
+      V3 d12 = xi - JKRDT::vec(x + 3 * j);
       const double rsq = JKRDT::dot(d12, d12);
-      const double radsum = radius[p] + radius[q];
+      const double radsum = by == BY_SCENE ? scene_K->radsum : radius[i] + radius[j];
       if (!bonded && rsq > radsum * radsum) continue;
+
+      // 2. orientation (p = particle 1) and constants
+      int p = i, q = j;
+      if (TANGENTIAL && tag[j] < tag[i]) {
+        std::swap(p, q);
+        d12 = -d12;
+      }
+      const JKRDT::ContactConstants &K = constants(p, q);
 
       // a grain of a fragment that has left for good meets nothing, and its own contacts
       // stand still: they are only evaluated, as a set-up does, for their potential energy
-      const bool p_own = p < nlocal, q_own = q < nlocal;
-      const double share = 0.5 * ((p_own ? 1.0 : 0.0) + (q_own ? 1.0 : 0.0));
+      const int owned = (p < nlocal) + (q < nlocal);    // a contact counts half per owned atom
       const bool parked = departed && ((mask[p] | mask[q]) & departed);
       if (parked && !(bonded && eflag)) {
-        if (bonded) acc.contacts += share;
+        if (bonded) acc.contact_ends += owned;
         continue;
       }
       const bool setup = run_setup || parked;
 
+      // 3. the motion over the step, and the guards that name a pair the step cannot resolve
       const double r = std::sqrt(rsq);
       const double delta = radsum - r;    // eq. (3)
-      if (!std::isfinite(delta) || r == 0.0) return trouble(Trouble::BLOW_UP, p, q, r, 0.0);
-
-      const JKRDT::ContactConstants *typed =
-          by_type ? &type_constants[type[p] * nstride + type[q]] : nullptr;
-      if (typed && typed->r1 == radius[p] && typed->r2 == radius[q]) {
-        Kp = typed;    // (a radius changed during the run, by fix adapt, takes the else)
-      } else {
-        Kp = &cached;
-        const Param &P = par(type[p], type[q]);
-        if (&P != last_param || radius[p] != last_r1 || radius[q] != last_r2) {
-          cached = JKRDT::contact_constants(P, radius[p], radius[q]);
-          last_param = &P;
-          last_r1 = radius[p];
-          last_r2 = radius[q];
-        }
-      }
-      const JKRDT::ContactConstants &K = *Kp;
-
+      if (!std::isfinite(delta) || r == 0.0) return trouble(Trouble::BLOW_UP, p, q, r, 0.0, K);
       JKRDT::ContactMotion m;
       m.d12 = d12;
       m.r = r;
       m.rinv = 1.0 / r;
       m.v12 = JKRDT::vec(v + 3 * p) - JKRDT::vec(v + 3 * q);
-      m.w1 = JKRDT::vec(omega + 3 * p);
-      m.w2 = JKRDT::vec(omega + 3 * q);
+      if (TANGENTIAL) {
+        m.w1 = JKRDT::vec(omega + 3 * p);
+        m.w2 = JKRDT::vec(omega + 3 * q);
+      }
       m.vn = JKRDT::dot(m.v12, d12) * m.rinv;    // at the half step, > 0 when separating
-
-      // a step must resolve the contact: name a pair too fast for the list
       const double step = parked ? 0.0 : std::fabs(m.vn) * dt;
-      if (step > half_skin) return trouble(Trouble::FAST_PAIR, p, q, m.vn, 0.0);
-      if (!setup) acc.step_max = std::max(acc.step_max, step / K.S.delta_c);
-
+      if (step > half_skin) return trouble(Trouble::FAST_PAIR, p, q, m.vn, 0.0, K);
+      if (!setup) acc.step_max = std::max(acc.step_max, step * K.inv_delta_c);
       const bool formed = !bonded;    // delta >= 0 here: contact formation (section 2.1)
       if (formed && setup && delta >= std::min(radius[p], radius[q]))
-        return trouble(Trouble::OVERLAP, p, q, delta, 0.0);
+        return trouble(Trouble::OVERLAP, p, q, delta, 0.0, K);
       // a contact forms within the step that closes the gap: deeper means it was missed
       if (formed && !setup && delta > 2.0 * step + LATE_SLACK * K.S.delta_c)
-        return trouble(Trouble::LATE, p, q, delta, step);
+        return trouble(Trouble::LATE, p, q, delta, step, K);
 
+      // 4. the contact over the step: the whole kernel, or its normal part alone
       double *state = layout.dnum ? slot_values + (bigint) s * layout.dnum : nullptr;
-      JKRDT::contact_step(K, layout, m, delta, dt, setup, formed, eflag, state, out);
-      const bool p_mine = p_own && (!thread_of_atom || thread_of_atom[p] == me);
-      const bool q_mine = q_own && (!thread_of_atom || thread_of_atom[q] == me);
-      const V3 &fp = out.F1;
-      if (!out.broken && !std::isfinite(fp.x + fp.y + fp.z))
-        return trouble(Trouble::NOT_FINITE, p, q, 0, 0);
-      bonded_slot[s] = !out.broken;
-
-      // force on p: normal (eq. 5 and A.5) plus sliding (eq. 14); torques eqs. (17), (23),
-      // (27); half of the step's dissipation to each owned atom
-      const V3 fq = -fp;
-      const struct {
-        int atom;
-        bool own, mine;
-        const V3 &f, &m;
-      } sides[2] = {{p, p_own, p_mine, fp, out.M1}, {q, q_own, q_mine, fq, out.M2}};
-      for (const auto &side : sides) {
-        if (!side.own || parked) continue;
-        const int a = side.atom;
-        double *fa, *ta, *la;
-        if (side.mine) {
-          fa = f[a];
-          ta = tq[a];
-          la = ledger[a];
-        } else {
-          FarLoad &l = far(a);
-          fa = l.f;
-          ta = l.torque;
-          la = l.loss;
-        }
-        if (!setup)
-          for (int l = 0; l < JKRDT::NLOSS; l++)
-            if (out.loss[l] != 0.0) la[l] += 0.5 * out.loss[l];
-        if (out.broken) continue;
-        fa[0] += side.f.x;
-        fa[1] += side.f.y;
-        fa[2] += side.f.z;
-        ta[0] += side.m.x;
-        ta[1] += side.m.y;
-        ta[2] += side.m.z;
+      V3 fp;
+      bool broken, lossy;
+      const double *loss;
+      double U_n;
+      JKRDT::NormalResult n;
+      double normal_loss[2];
+      if (TANGENTIAL) {
+        JKRDT::contact_step(K, layout, m, delta, dt, setup, formed, eflag, state, out);
+        fp = out.F1;
+        broken = out.broken;
+        lossy = out.lossy;
+        loss = out.loss;
+        U_n = out.U_n;
+      } else {
+        JKRDT::normal_step(K, layout, m.vn, delta, dt, setup, formed, eflag, state, n);
+        fp = (n.f * m.rinv) * d12;
+        broken = n.broken;
+        lossy = n.lossy;
+        normal_loss[JKRDT::LOSS_FORM_BREAK] = n.loss_event;
+        normal_loss[JKRDT::LOSS_DAMPING] = n.loss_damping;
+        loss = normal_loss;
+        U_n = n.U_n;
       }
-      if (out.broken) continue;
-      acc.contacts += share;
+      constexpr int nloss = TANGENTIAL ? JKRDT::NLOSS : JKRDT::LOSS_DAMPING + 1;
+      if (!broken && !std::isfinite(fp.x + fp.y + fp.z))
+        return trouble(Trouble::NOT_FINITE, p, q, 0, 0, K);
+      bonded_slot[s] = !broken;
+
+      // 5. force on p: normal (eq. 5 and A.5) plus sliding (eq. 14), -force on q; torques
+      // eqs. (17), (23), (27); half of the step's dissipation to each owned atom
+      if (!parked)
+        for (int side = 0; side < 2; side++) {
+          const int a = side ? q : p;
+          if (a >= nlocal) continue;
+          double *fa, *ta, *la;
+          if (!thread_of_atom || thread_of_atom[a] == me) {
+            fa = f[a];
+            ta = tq[a];
+            la = ledger[a];
+          } else {
+            acc.far.push_back(FarLoad{a, {0, 0, 0}, {0, 0, 0}, {0, 0, 0, 0, 0}});
+            fa = acc.far.back().f;
+            ta = acc.far.back().torque;
+            la = acc.far.back().loss;
+          }
+          if (lossy && !setup)
+            for (int l = 0; l < nloss; l++) la[l] += 0.5 * loss[l];
+          if (broken) continue;
+          const V3 fa_add = side ? -fp : fp;
+          fa[0] += fa_add.x;
+          fa[1] += fa_add.y;
+          fa[2] += fa_add.z;
+          if (TANGENTIAL) {
+            const V3 &ma = side ? out.M2 : out.M1;
+            ta[0] += ma.x;
+            ta[1] += ma.y;
+            ta[2] += ma.z;
+          }
+        }
+      if (broken) continue;
+
+      // energy and virial
+      acc.contact_ends += owned;
       if (!eflag && !vflag_either) continue;
-      const double u = out.U_n + out.U[0] + out.U[1] + out.U[2];
+      const double share = 0.5 * owned;
+      const double u = TANGENTIAL ? U_n + out.U[0] + out.U[1] + out.U[2] : U_n;
       if (eflag) {
-        acc.upot += share * out.U_n;
-        for (int ch = 0; ch < JKRDT::NCHANNEL; ch++) acc.utan[ch] += share * out.U[ch];
+        acc.upot += share * U_n;
+        if (TANGENTIAL)
+          for (int ch = 0; ch < JKRDT::NCHANNEL; ch++) acc.utan[ch] += share * out.U[ch];
       }
       if (tally_atoms) {
         ev_tally_xyz(p, q, nlocal, 0, u, 0.0, fp.x, fp.y, fp.z, d12.x, d12.y, d12.z);
@@ -522,6 +607,11 @@ void PairJKRDT::fill_pvector(double upot, const double *utan, double contacts)
                  "pair jkr/dt: value {} of the energy ledger is not finite at step {} (timestep "
                  "= {:.3g} t_c): the run has blown up; reduce the timestep",
                  l + 1, update->ntimestep, update->dt / tc_min);
+}
+
+PairJKRDT *PairJKRDT::active(LAMMPS *lmp)
+{
+  return dynamic_cast<PairJKRDT *>(lmp->force->pair_match("jkr/dt", 1, 0));
 }
 
 FixJKRDTContacts *PairJKRDT::contacts()

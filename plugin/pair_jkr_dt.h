@@ -13,6 +13,7 @@
 
 #include "pair.h"
 
+#include "fix_jkr_dt_contacts.h"
 #include "jkr_dt_contact.h"
 
 #include <string>
@@ -20,15 +21,16 @@
 
 namespace LAMMPS_NS {
 
-class FixJKRDTContacts;
-
 class PairJKRDT : public Pair {
  public:
-  // what pair_coeff gave for one type pair; NaN or -1 = not given
+  // the pair_coeff keywords; their table (pair_jkr_dt_coeff.cpp) says how each is read,
+  // checked, mixed and written to data and restart files
+  enum Key { GAMMA, E, NU, G, XI_CRIT, TVIS, KS_SCALE, KR_SCALE, KT_SCALE,
+             SLIDING, ROLLING, TWISTING, NKEY };
+  // what pair_coeff gave for one type pair, by keyword: NaN = not given; a switch is 1 or 0
   struct Input {
-    double gamma, E, nu, G, xi_crit, tvis;
-    double ks_scale, kr_scale, kt_scale;
-    int sliding, rolling, twisting;
+    double v[NKEY];
+    bool given(Key k) const { return v[k] == v[k]; }
   };
 
   // the parameters of one type pair after defaults and mixing: the kernel's
@@ -82,14 +84,18 @@ class PairJKRDT : public Pair {
   double memory_usage() override;
 
   bool bonded_contact(int i, int j, ContactView &view) const;
-  void report_run();         // end of a run: the largest step a contact took
+  // the pair style found by its style name (in a hybrid too), or null
+  static PairJKRDT *active(class LAMMPS *lmp);
+
+  // what the contact store asks of its writer (FixJKRDTContacts::Writer)
+  void run_ended();                   // the largest step a contact took this run
+  [[noreturn]] void contact_lost();   // a stored contact missing from the list
   double t_c() const { return tc_min; }
   // the least energy that breaks a bonded contact, eq. (6) from equilibrium to -delta_c,
   // over the type pairs present, and the mass of the lightest grain
   double weakest_contact(double &lightest) const;
   // the contact store with its per-atom rows current (for readers between the steps)
   FixJKRDTContacts *contacts();
-  void report_lost_contact();    // a stored contact missing from the neighbor list
   // bins that grow with the box (pair_jkr_dt_bins.cpp); before each reneighboring
   static constexpr double BINS_PER_GRAIN = 32.0;
   // cutneigh: the neighbor cutoff (Neighbor's cutneighmax once it is set up)
@@ -105,6 +111,13 @@ class PairJKRDT : public Pair {
   // monodisperse scene): looked up, never recomputed, in the pair loop
   std::vector<JKRDT::ContactConstants> type_constants;
   bool one_radius_per_type;
+  bool any_tangential;         // some type pair present has a tangential channel
+  int scene_pair;              // a type pair whose constants every pair present shares; -1: none
+  enum ConstantsBy { BY_SCENE, BY_TYPE, BY_RADII };
+  ConstantsBy constants_by();
+  ConstantsBy constants_source;   // the last answer of constants_by() ...
+  bigint radii_checked;           // ... checked at this neighbor list build
+  bool radii_adapt;               // a fix adapt may change radii at any step
   int dt_check;                // DtCheck: what a time step above DT_STABLE t_c does
   double tc_min;               // smallest t_c over the type pairs present
   int tc_types[2];             // the type pair of tc_min
@@ -112,7 +125,7 @@ class PairJKRDT : public Pair {
   double dt_warned;            // the time step last checked (warnings once per dt)
   bigint checked_laststep;     // the run whose time step was checked
   double step_max;             // largest |v_n| dt / delta_c of a contact this run, this rank
-  bool step_warned;            // the warning of report_run() is given once
+  bool step_warned;            // the warning of run_ended() is given once
   bigint contacts_at_run_end;  // bonded contacts when the last run ended (write_data marks it)
   bigint data_contacts;        // contacts a data file read by read_data left behind
   FixJKRDTContacts *fix_contacts;
@@ -167,10 +180,13 @@ class PairJKRDT : public Pair {
     int thread;
     const int *thread_of;           // owning thread of each owned atom; null: one thread
     std::vector<FarLoad> far;
-    double upot, contacts, utan[JKRDT::NCHANNEL], eng, virial[6], step_max;
+    double upot, utan[JKRDT::NCHANNEL], eng, virial[6], step_max;
+    bigint contact_ends;            // bonded contacts counted once per owned atom
     Trouble trouble;                // the first problem met; the thread stops there
   };
-  void pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, Accumulator &acc);
+  template <bool TANGENTIAL>
+  void pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, ConstantsBy by,
+                 Accumulator &acc);
   [[noreturn]] void report(const Trouble &t) const;
   int nthreads_used() const;
   std::vector<int> thread_of;         // owning thread of each owned atom (threaded runs)

@@ -34,6 +34,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <string>
 #include <vector>
@@ -41,10 +42,70 @@
 using namespace LAMMPS_NS;
 
 static constexpr double UNSET = std::numeric_limits<double>::quiet_NaN();
-static const PairJKRDT::Input NOTHING_GIVEN = {UNSET, UNSET, UNSET, UNSET, UNSET, UNSET,
-                                               UNSET, UNSET, UNSET, -1,    -1,    -1};
+using Key = PairJKRDT::Key;
 
-static bool given(double x) { return !std::isnan(x); }
+/* ----------------------------------------------------------------------
+   the pair_coeff keywords: one row each drives the parsing, the error
+   messages, the mixing of unlike types, data files and restart files
+   (which name their keywords, so a file written before a keyword was added
+   reads back with that keyword unset)
+------------------------------------------------------------------------- */
+
+namespace {
+enum class Value { POSITIVE, POISSON, NONNEGATIVE, SWITCH };
+enum class Mix {
+  MATERIAL,     // E, nu, G: each side's own, into eqs. (2), (13) and (A.5)
+  GEOMETRIC,    // sqrt(a b)
+  MEAN,         // (a + b) / 2, unset if either is
+  MEAN_OR_0,    // (a + b) / 2, an unset side counts 0
+  MEAN_OR_1,    // (a + b) / 2, an unset side counts 1
+  BOTH_ON       // on where both sides are (unset counts as on)
+};
+struct Keyword {
+  Key key;
+  const char *name;
+  Value value;
+  Mix mix;
+};
+constexpr Keyword KEYWORDS[PairJKRDT::NKEY] = {
+    {PairJKRDT::GAMMA, "gamma", Value::POSITIVE, Mix::GEOMETRIC},
+    {PairJKRDT::E, "E", Value::POSITIVE, Mix::MATERIAL},
+    {PairJKRDT::NU, "nu", Value::POISSON, Mix::MATERIAL},
+    {PairJKRDT::G, "G", Value::POSITIVE, Mix::MATERIAL},
+    {PairJKRDT::XI_CRIT, "xi_crit", Value::POSITIVE, Mix::MEAN},
+    {PairJKRDT::TVIS, "tvis", Value::NONNEGATIVE, Mix::MEAN_OR_0},
+    {PairJKRDT::KS_SCALE, "ks_scale", Value::POSITIVE, Mix::MEAN_OR_1},
+    {PairJKRDT::KR_SCALE, "kr_scale", Value::POSITIVE, Mix::MEAN_OR_1},
+    {PairJKRDT::KT_SCALE, "kt_scale", Value::POSITIVE, Mix::MEAN_OR_1},
+    {PairJKRDT::SLIDING, "sliding", Value::SWITCH, Mix::BOTH_ON},
+    {PairJKRDT::ROLLING, "rolling", Value::SWITCH, Mix::BOTH_ON},
+    {PairJKRDT::TWISTING, "twisting", Value::SWITCH, Mix::BOTH_ON},
+};
+// keywords that are not values of a type pair
+constexpr const char *FRICTIONLESS = "frictionless";     // sliding, rolling, twisting off
+constexpr const char *DATA_CONTACTS = "data_contacts";   // write_data's mark
+
+const Keyword *keyword(const std::string &word)
+{
+  for (const Keyword &k : KEYWORDS)
+    if (word == k.name) return &k;
+  return nullptr;
+}
+
+std::string keyword_list()
+{
+  std::string all;
+  for (const Keyword &k : KEYWORDS) all += std::string(k.name) + " ";
+  return all + FRICTIONLESS;
+}
+
+PairJKRDT::Input nothing_given()
+{
+  PairJKRDT::Input g;
+  std::fill(g.v, g.v + PairJKRDT::NKEY, UNSET);
+  return g;
+}
+}    // namespace
 
 /* ---------------------------------------------------------------------- */
 
@@ -93,7 +154,7 @@ void PairJKRDT::allocate()
   memory->create(cutsq, n + 1, n + 1, "pair:cutsq");
   for (int i = 0; i <= n; i++)
     for (int j = 0; j <= n; j++) setflag[i][j] = 0;
-  input.assign(nstride * nstride, NOTHING_GIVEN);
+  input.assign(nstride * nstride, nothing_given());
   param.assign(nstride * nstride, Param());
   maxrad.assign(nstride, 0.0);
 }
@@ -109,92 +170,62 @@ void PairJKRDT::coeff(int narg, char **arg)
   utils::bounds(FLERR, arg[0], 1, atom->ntypes, ilo, ihi, error);
   utils::bounds(FLERR, arg[1], 1, atom->ntypes, jlo, jhi, error);
 
-  Input g = NOTHING_GIVEN;
+  Input g = nothing_given();
   bigint marked = 0;
   int iarg = 2;
-  static const std::vector<std::string> keywords = {
-      "gamma",   "E",       "nu",       "G",        "xi_crit",  "tvis",    "sliding",
-      "rolling", "twisting", "frictionless", "ks_scale", "kr_scale", "kt_scale", "data_contacts"};
-  auto is_keyword = [&](const char *word) {
-    return std::find(keywords.begin(), keywords.end(), word) != keywords.end();
-  };
   auto value = [&](const std::string &key) -> const char * {
-    if (iarg + 1 >= narg || is_keyword(arg[iarg + 1]))
+    if (iarg + 1 >= narg || keyword(arg[iarg + 1]) || arg[iarg + 1] == std::string(FRICTIONLESS))
       error->all(FLERR, "pair_coeff for jkr/dt: keyword '{}' needs a value{}", key,
                  iarg + 1 < narg ? fmt::format(" (next is the keyword '{}')", arg[iarg + 1])
                                  : std::string(" (the line ends)"));
     return arg[iarg + 1];
   };
-  auto on_off = [&](const std::string &key) {
-    const std::string word = value(key);
-    if (word == "on" || word == "yes" || word == "true") return 1;
-    if (word == "off" || word == "no" || word == "false") return 0;
-    error->all(FLERR, "pair_coeff for jkr/dt: {} takes on or off (got '{}')", key, word);
-    return 0;
-  };
-  auto positive = [&](const std::string &key) {
-    const double x = utils::numeric(FLERR, value(key), false, lmp);
-    if (!(x > 0.0)) error->all(FLERR, "pair_coeff for jkr/dt: {} must be > 0 (got {})", key, x);
+  auto read = [&](const Keyword &k) -> double {
+    if (k.value == Value::SWITCH) {
+      const std::string word = value(k.name);
+      if (word == "on" || word == "yes" || word == "true") return 1.0;
+      if (word == "off" || word == "no" || word == "false") return 0.0;
+      error->all(FLERR, "pair_coeff for jkr/dt: {} takes on or off (got '{}')", k.name, word);
+    }
+    const double x = utils::numeric(FLERR, value(k.name), false, lmp);
+    if (k.value == Value::POSITIVE && !(x > 0.0))
+      error->all(FLERR, "pair_coeff for jkr/dt: {} must be > 0 (got {})", k.name, x);
+    if (k.value == Value::POISSON && !(x > -1.0 && x < 0.5))
+      error->all(FLERR, "pair_coeff for jkr/dt: {} must lie in (-1, 0.5) (got {})", k.name, x);
+    if (k.value == Value::NONNEGATIVE && !(x >= 0.0))
+      error->all(FLERR, "pair_coeff for jkr/dt: {} must be >= 0; 0 means none (got {})", k.name,
+                 x);
     return x;
   };
 
   while (iarg < narg) {
     const std::string key = arg[iarg];
-    if (key == "gamma") {
-      g.gamma = positive(key);
-    } else if (key == "E") {
-      g.E = positive(key);
-    } else if (key == "G") {
-      g.G = positive(key);
-    } else if (key == "xi_crit") {
-      g.xi_crit = positive(key);
-    } else if (key == "ks_scale") {
-      g.ks_scale = positive(key);
-    } else if (key == "kr_scale") {
-      g.kr_scale = positive(key);
-    } else if (key == "kt_scale") {
-      g.kt_scale = positive(key);
-    } else if (key == "nu") {
-      g.nu = utils::numeric(FLERR, value(key), false, lmp);
-      if (!(g.nu > -1.0 && g.nu < 0.5))
-        error->all(FLERR, "pair_coeff for jkr/dt: nu must lie in (-1, 0.5) (got {})", g.nu);
-    } else if (key == "tvis") {
-      g.tvis = utils::numeric(FLERR, value(key), false, lmp);
-      if (!(g.tvis >= 0.0))
-        error->all(FLERR, "pair_coeff for jkr/dt: tvis must be >= 0; 0 means no damping (got {})",
-                   g.tvis);
-    } else if (key == "sliding") {
-      g.sliding = on_off(key);
-    } else if (key == "rolling") {
-      g.rolling = on_off(key);
-    } else if (key == "twisting") {
-      g.twisting = on_off(key);
-    } else if (key == "frictionless") {
-      g.sliding = g.rolling = g.twisting = 0;
+    if (const Keyword *k = keyword(key)) {
+      g.v[k->key] = read(*k);
+    } else if (key == FRICTIONLESS) {
+      g.v[SLIDING] = g.v[ROLLING] = g.v[TWISTING] = 0.0;
       iarg += 1;
       continue;
-    } else if (key == "data_contacts") {
+    } else if (key == DATA_CONTACTS) {
       marked = utils::bnumeric(FLERR, value(key), false, lmp);    // written by write_data
     } else {
-      error->all(FLERR,
-                 "pair_coeff for jkr/dt: unknown keyword '{}'; allowed: gamma E nu G xi_crit "
-                 "tvis sliding rolling twisting frictionless ks_scale kr_scale kt_scale",
-                 key);
+      error->all(FLERR, "pair_coeff for jkr/dt: unknown keyword '{}'; allowed: {}", key,
+                 keyword_list());
     }
     iarg += 2;
   }
 
-  if (given(g.E) != given(g.nu))
+  if (g.given(E) != g.given(NU))
     error->all(FLERR, "pair_coeff for jkr/dt: E and nu go together; give both or neither");
-  if (given(g.G) && !given(g.E))
+  if (g.given(G) && !g.given(E))
     error->all(FLERR, "pair_coeff for jkr/dt: G needs E and nu on the same line");
 
   int count = 0;
   for (int i = ilo; i <= ihi; i++)
     for (int j = std::max(jlo, i); j <= jhi; j++) {
-      if (i == j && !(given(g.gamma) && given(g.E))) {
-        std::string missing = given(g.gamma) ? "" : "gamma";
-        if (!given(g.E)) missing += missing.empty() ? "E and nu" : ", E and nu";
+      if (i == j && !(g.given(GAMMA) && g.given(E))) {
+        std::string missing = g.given(GAMMA) ? "" : "gamma";
+        if (!g.given(E)) missing += missing.empty() ? "E and nu" : ", E and nu";
         error->all(FLERR,
                    "pair_coeff {} {} for jkr/dt: a type's own line must give its material; "
                    "missing: {}",
@@ -219,37 +250,44 @@ PairJKRDT::Param PairJKRDT::resolve(int i, int j) const
   const Input &ij = in(i, j), &ii = in(i, i), &jj = in(j, j);
   const bool own = setflag[i][j] != 0;
 
-  // material of the two sides: the pair's own line if it gives one, else each type's
-  const Input &m1 = (own && given(ij.E)) ? ij : ii;
-  const Input &m2 = (own && given(ij.E)) ? ij : jj;
-  auto shear = [](const Input &m) { return given(m.G) ? m.G : m.E / (2.0 * (1.0 + m.nu)); };
+  // a keyword's value for the pair: its own line's if given, else mixed by the table
+  auto mixed = [&](Key key) {
+    if (own && ij.given(key)) return ij.v[key];
+    const double a = ii.v[key], b = jj.v[key];
+    switch (KEYWORDS[key].mix) {
+      case Mix::GEOMETRIC: return std::sqrt(a * b);
+      case Mix::MEAN: return 0.5 * (a + b);
+      case Mix::MEAN_OR_0: return 0.5 * ((a == a ? a : 0.0) + (b == b ? b : 0.0));
+      case Mix::MEAN_OR_1: return 0.5 * ((a == a ? a : 1.0) + (b == b ? b : 1.0));
+      case Mix::BOTH_ON: return (a != 0.0 && b != 0.0) ? 1.0 : 0.0;    // unset (NaN) is on
+      case Mix::MATERIAL: break;
+    }
+    return UNSET;
+  };
+
+  // material of the two sides (Mix::MATERIAL): the pair's own line if it gives one, else
+  // each type's
+  const Input &m1 = (own && ij.given(E)) ? ij : ii;
+  const Input &m2 = (own && ij.given(E)) ? ij : jj;
+  auto shear = [](const Input &m) {
+    return m.given(G) ? m.v[G] : m.v[E] / (2.0 * (1.0 + m.v[NU]));
+  };
+  const double nu1 = m1.v[NU], nu2 = m2.v[NU];
 
   Param P;
-  P.Estar = 1.0 / ((1.0 - m1.nu * m1.nu) / m1.E + (1.0 - m2.nu * m2.nu) / m2.E);    // eq. (2)
-  P.Gstar = 1.0 / ((2.0 - m1.nu) / shear(m1) + (2.0 - m2.nu) / shear(m2));          // eq. (13)
-  P.Gred = 1.0 / (1.0 / shear(m1) + 1.0 / shear(m2));                               // below eq. (26)
-  P.nu = 0.5 * (m1.nu + m2.nu);
+  P.Estar = 1.0 / ((1.0 - nu1 * nu1) / m1.v[E] + (1.0 - nu2 * nu2) / m2.v[E]);    // eq. (2)
+  P.Gstar = 1.0 / ((2.0 - nu1) / shear(m1) + (2.0 - nu2) / shear(m2));          // eq. (13)
+  P.Gred = 1.0 / (1.0 / shear(m1) + 1.0 / shear(m2));                           // below eq. (26)
+  P.nu = 0.5 * (nu1 + nu2);
 
-  auto mean = [](double a, double b) { return 0.5 * (a + b); };
-  auto zero_if_unset = [](double x) { return given(x) ? x : 0.0; };
-  P.gamma = (own && given(ij.gamma)) ? ij.gamma : std::sqrt(ii.gamma * jj.gamma);
-  P.xi_crit = (own && given(ij.xi_crit)) ? ij.xi_crit : mean(ii.xi_crit, jj.xi_crit);
-  P.tvis = (own && given(ij.tvis)) ? ij.tvis : mean(zero_if_unset(ii.tvis), zero_if_unset(jj.tvis));
-  auto scale = [&](double own_value, double a, double b) {
-    auto one_if_unset = [](double x) { return given(x) ? x : 1.0; };
-    return (own && given(own_value)) ? own_value : mean(one_if_unset(a), one_if_unset(b));
-  };
-  const double ks_scale = scale(ij.ks_scale, ii.ks_scale, jj.ks_scale);
-  const double kr_scale = scale(ij.kr_scale, ii.kr_scale, jj.kr_scale);
-  const double kt_scale = scale(ij.kt_scale, ii.kt_scale, jj.kt_scale);
-
-  auto channel = [&](int own_flag, int a, int b) {
-    if (own && own_flag >= 0) return own_flag;
-    return (a != 0 && b != 0) ? 1 : 0;    // unset (-1) counts as on
-  };
-  P.sliding = channel(ij.sliding, ii.sliding, jj.sliding);
-  P.rolling = channel(ij.rolling, ii.rolling, jj.rolling);
-  P.twisting = channel(ij.twisting, ii.twisting, jj.twisting);
+  P.gamma = mixed(GAMMA);
+  P.xi_crit = mixed(XI_CRIT);
+  P.tvis = mixed(TVIS);
+  const double ks_scale = mixed(KS_SCALE), kr_scale = mixed(KR_SCALE);
+  const double kt_scale = mixed(KT_SCALE);
+  P.sliding = mixed(SLIDING) != 0.0;
+  P.rolling = mixed(ROLLING) != 0.0;
+  P.twisting = mixed(TWISTING) != 0.0;
   // in 2D omega lies along z and n_c in the plane: the twisting angle of eq. (24) stays 0,
   // so the channel is off and its angle is not stored
   if (domain->dimension == 2) P.twisting = 0;
@@ -293,21 +331,28 @@ double PairJKRDT::init_one(int i, int j)
    so a continued run mixes exactly as the first one did
 ------------------------------------------------------------------------- */
 
-static void write_input(FILE *fp, const PairJKRDT::Input &g)
-{
-  const double d[9] = {g.gamma, g.E, g.nu, g.G, g.xi_crit, g.tvis,
-                       g.ks_scale, g.kr_scale, g.kt_scale};
-  const int k[3] = {g.sliding, g.rolling, g.twisting};
-  fwrite(d, sizeof(double), 9, fp);
-  fwrite(k, sizeof(int), 3, fp);
-}
+// a restart file's coefficients: NAMED, then the keywords by name, then each type pair's
+// setflag and, if set, one double per keyword in that order. A file of the first builds
+// (positional: 9 doubles and 3 ints, no names) starts with the first setflag instead
+static constexpr int NAMED = -2;
+static constexpr int LEGACY_ORDER[PairJKRDT::NKEY] = {
+    PairJKRDT::GAMMA,    PairJKRDT::E,        PairJKRDT::NU,       PairJKRDT::G,
+    PairJKRDT::XI_CRIT,  PairJKRDT::TVIS,     PairJKRDT::KS_SCALE, PairJKRDT::KR_SCALE,
+    PairJKRDT::KT_SCALE, PairJKRDT::SLIDING,  PairJKRDT::ROLLING,  PairJKRDT::TWISTING};
 
 void PairJKRDT::write_restart(FILE *fp)
 {
+  const int head[2] = {NAMED, NKEY};
+  fwrite(head, sizeof(int), 2, fp);
+  for (const Keyword &k : KEYWORDS) {
+    const int length = (int) std::strlen(k.name);
+    fwrite(&length, sizeof(int), 1, fp);
+    fwrite(k.name, 1, length, fp);
+  }
   for (int i = 1; i <= atom->ntypes; i++)
     for (int j = i; j <= atom->ntypes; j++) {
       fwrite(&setflag[i][j], sizeof(int), 1, fp);
-      if (setflag[i][j]) write_input(fp, in(i, j));
+      if (setflag[i][j]) fwrite(in(i, j).v, sizeof(double), NKEY, fp);
     }
 }
 
@@ -315,20 +360,59 @@ void PairJKRDT::read_restart(FILE *fp)
 {
   allocate();
   const int me = comm->me;
+  auto read_ints = [&](int *x, int n) {
+    if (me == 0) utils::sfread(FLERR, x, sizeof(int), n, fp, nullptr, error);
+    MPI_Bcast(x, n, MPI_INT, 0, world);
+  };
+  auto read_doubles = [&](double *x, int n) {
+    if (me == 0) utils::sfread(FLERR, x, sizeof(double), n, fp, nullptr, error);
+    MPI_Bcast(x, n, MPI_DOUBLE, 0, world);
+  };
+  int first;
+  read_ints(&first, 1);
+  std::vector<int> order;    // the file's keywords, as keys of this build
+  if (first == NAMED) {
+    int count;
+    read_ints(&count, 1);
+    for (int n = 0; n < count; n++) {
+      int length;
+      read_ints(&length, 1);
+      std::string name(length, ' ');
+      if (me == 0) utils::sfread(FLERR, &name[0], 1, length, fp, nullptr, error);
+      MPI_Bcast(&name[0], length, MPI_CHAR, 0, world);
+      const Keyword *k = keyword(name);
+      if (!k)
+        error->all(FLERR,
+                   "pair jkr/dt: the restart file has the pair_coeff keyword '{}', which this "
+                   "build does not know; read it with the build that wrote it, or give "
+                   "pair_coeff anew after read_restart",
+                   name);
+      order.push_back(k->key);
+    }
+  } else {
+    order.assign(LEGACY_ORDER, LEGACY_ORDER + NKEY);
+  }
   for (int i = 1; i <= atom->ntypes; i++)
     for (int j = i; j <= atom->ntypes; j++) {
-      if (me == 0) utils::sfread(FLERR, &setflag[i][j], sizeof(int), 1, fp, nullptr, error);
-      MPI_Bcast(&setflag[i][j], 1, MPI_INT, 0, world);
+      if (i == 1 && j == 1 && first != NAMED)
+        setflag[i][j] = first;
+      else
+        read_ints(&setflag[i][j], 1);
       if (!setflag[i][j]) continue;
-      double d[9];
-      int k[3];
-      if (me == 0) {
-        utils::sfread(FLERR, d, sizeof(double), 9, fp, nullptr, error);
-        utils::sfread(FLERR, k, sizeof(int), 3, fp, nullptr, error);
+      Input &g = in(i, j);
+      g = nothing_given();
+      if (first == NAMED) {
+        std::vector<double> v(order.size());
+        read_doubles(v.data(), (int) v.size());
+        for (size_t n = 0; n < order.size(); n++) g.v[order[n]] = v[n];
+      } else {
+        double d[9];
+        int k[3];
+        read_doubles(d, 9);
+        read_ints(k, 3);
+        for (int n = 0; n < 9; n++) g.v[order[n]] = d[n];
+        for (int n = 0; n < 3; n++) g.v[order[9 + n]] = k[n] < 0 ? UNSET : k[n];
       }
-      MPI_Bcast(d, 9, MPI_DOUBLE, 0, world);
-      MPI_Bcast(k, 3, MPI_INT, 0, world);
-      in(i, j) = {d[0], d[1], d[2], d[3], d[4], d[5], d[6], d[7], d[8], k[0], k[1], k[2]};
     }
 }
 
@@ -341,17 +425,15 @@ void PairJKRDT::read_restart(FILE *fp)
 std::string PairJKRDT::coeff_words(const Input &g) const
 {
   std::string line;
-  const std::pair<const char *, double> reals[] = {
-      {"gamma", g.gamma},     {"E", g.E},       {"nu", g.nu},
-      {"G", g.G},             {"xi_crit", g.xi_crit}, {"tvis", g.tvis},
-      {"ks_scale", g.ks_scale}, {"kr_scale", g.kr_scale}, {"kt_scale", g.kt_scale}};
-  for (const auto &kv : reals)
-    if (given(kv.second)) line += fmt::format(" {} {:.17g}", kv.first, kv.second);
-  const std::pair<const char *, int> flags[] = {
-      {"sliding", g.sliding}, {"rolling", g.rolling}, {"twisting", g.twisting}};
-  for (const auto &kv : flags)
-    if (kv.second >= 0) line += fmt::format(" {} {}", kv.first, kv.second ? "on" : "off");
-  if (contacts_at_run_end > 0) line += fmt::format(" data_contacts {}", contacts_at_run_end);
+  for (const Keyword &k : KEYWORDS) {
+    if (!g.given(k.key)) continue;
+    if (k.value == Value::SWITCH)
+      line += fmt::format(" {} {}", k.name, g.v[k.key] != 0.0 ? "on" : "off");
+    else
+      line += fmt::format(" {} {:.17g}", k.name, g.v[k.key]);
+  }
+  if (contacts_at_run_end > 0)
+    line += fmt::format(" {} {}", DATA_CONTACTS, contacts_at_run_end);
   return line;
 }
 

@@ -295,7 +295,7 @@ void PairJKRDT::report_late_contact(int p, int q, double delta, double step,
    a stored contact that the new neighbor list does not hold: say why and stop
 ------------------------------------------------------------------------- */
 
-void PairJKRDT::report_lost_contact()
+void PairJKRDT::contact_lost()
 {
   const int nlocal = atom->nlocal;
   const tagint *tag = atom->tag;
@@ -355,7 +355,7 @@ void PairJKRDT::report_lost_contact()
    closes, but the loss of one event is then off by O(F_c |v_n| dt / 2)
 ------------------------------------------------------------------------- */
 
-void PairJKRDT::report_run()
+void PairJKRDT::run_ended()
 {
   double most = 0.0;
   MPI_Allreduce(&step_max, &most, 1, MPI_DOUBLE, MPI_MAX, world);

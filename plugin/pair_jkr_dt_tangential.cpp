@@ -58,7 +58,7 @@ void PairJKRDT::book_channels_switched_off(const std::vector<Param> &fresh, Cont
       const double dist = norm(d12);
       const ContactConstants K = contact_constants(before, atom->radius[p], atom->radius[q]);
       ChannelLoad load[NCHANNEL];
-      tangential_load(c, (1.0 / dist) * d12, dist, K.r1, K.r2, K.S.R, K.K, load);
+      tangential_load(c, (1.0 / dist) * d12, 1.0 / dist, K.r1, K.r2, K.S.R, K.K, load);
       for (int ch = 0; ch < NCHANNEL; ch++)
         if (off[ch]) C.ledger[i][LOSS_SLIDING + ch] += 0.5 * load[ch].U;
     }

@@ -414,3 +414,43 @@ def test_a_restart_written_during_a_run_holds_that_steps_contacts(tmp_path):
     finally:
         again.close()
     assert np.array_equal(x1, x0) and np.array_equal(w1, w0)
+
+
+# the three pair_coeff lines of tests/data/coeffs_by_position.restart, as the plugin that
+# wrote it (one that stored the coefficients by position, 9 doubles and 3 ints) wrote them
+# with write_coeff after its run (less the mark of that run's contact, " data_contacts 1")
+COEFFS_BY_POSITION = [
+    "pair_coeff 1 1 gamma 0.10000000000000001 E 7000000000 nu 0.25 "
+    "xi_crit 8.0000000000000003e-10 tvis 2e-12",
+    "pair_coeff 1 2 gamma 0.14999999999999999 ks_scale 2 twisting off",
+    "pair_coeff 2 2 gamma 0.25 E 54000000000 nu 0.17000000000000001 G 20000000000 "
+    "xi_crit 2.0000000000000001e-10 kr_scale 0.5 rolling off",
+]
+
+
+def coeff_lines(lmp, path):
+    lmp.command(f"write_coeff {path}")
+    return [line.split(" data_contacts")[0] for line in Path(path).read_text().splitlines()
+            if line.startswith("pair_coeff")]
+
+
+def test_restart_files_name_their_coefficients_and_old_ones_read_back(tmp_path):
+    # a file of the first builds holds its coefficients by position; this build writes them
+    # by name, so that a file written before a keyword was added reads back without it.
+    # Both give back every keyword of every line given, unset ones unset
+    lmp = start_lammps()
+    try:
+        lmp.command(f"read_restart {Path(__file__).parent / 'data' / 'coeffs_by_position.restart'}")
+        assert coeff_lines(lmp, tmp_path / "old.coeff") == COEFFS_BY_POSITION
+        lmp.command(f"write_restart {tmp_path / 'named.restart'}")
+    finally:
+        lmp.close()
+    named = (tmp_path / "named.restart").read_bytes()
+    for word in (b"gamma", b"xi_crit", b"kt_scale", b"twisting"):
+        assert word in named
+    lmp = start_lammps()
+    try:
+        lmp.command(f"read_restart {tmp_path / 'named.restart'}")
+        assert coeff_lines(lmp, tmp_path / "named.coeff") == COEFFS_BY_POSITION
+    finally:
+        lmp.close()

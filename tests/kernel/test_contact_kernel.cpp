@@ -266,6 +266,56 @@ static void elastic_oscillation()
         0.0, bound);
 }
 
+// the step's fast forms against the plain ones: the two pointers turned in lanes equal two
+// scalar turns bit for bit (the same operations in the same order), and the channels'
+// loads summed with one cross product per particle equal the sum of each channel's load
+// of eqs. (14)-(27) to round-off (a few ulps of the largest term)
+static void fast_forms()
+{
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  auto random_unit = [&]() { return unit(V3{u(rng), u(rng), u(rng)}); };
+  int differ = 0;
+  for (int k = 0; k < 1000; k++) {
+    const double scale = std::pow(10.0, -4.0 * (k % 4) - 1.0);    // |w| from 0.1 to 1e-13
+    const V3 w1 = scale * V3{u(rng), u(rng), u(rng)}, w2 = scale * V3{u(rng), u(rng), u(rng)};
+    V3 n1 = random_unit(), n2 = random_unit();
+    const V3 one = turned(n1, w1), two = turned(n2, w2);
+    turned(n1, w1, n2, w2);
+    differ += (n1.x != one.x) + (n1.y != one.y) + (n1.z != one.z) + (n2.x != two.x) +
+        (n2.y != two.y) + (n2.z != two.z);
+  }
+  check(differ == 0, "pointers turned in lanes = two scalar turns (components that differ)",
+        differ, 0, 0);
+
+  const ContactConstants c = contact_constants(ice(true, true, true), R_GRAIN, R_GRAIN);
+  double worst = 0.0;
+  for (int k = 0; k < 1000; k++) {
+    const V3 nc = random_unit();
+    const double tilt = 2.0 * c.K.zeta_crit / R_GRAIN;
+    ContactState st = {unit(-1.0 * nc + tilt * random_unit()), unit(nc + tilt * random_unit()),
+                       2.0 * c.K.phi_crit * u(rng)};
+    const Displacements d = displacements(st, nc, R_GRAIN, R_GRAIN, c.S.R);
+    const double rinv = 1.0 / (2.0 * R_GRAIN - c.S.delta0);
+    ChannelLoad load[NCHANNEL];
+    tangential_load(st, d, nc, rinv, R_GRAIN, R_GRAIN, c.S.R, c.K, load);
+    V3 F = {0, 0, 0}, M1 = F, M2 = F, Fs = F, M1s = F, M2s = F;
+    double U[NCHANNEL] = {0, 0, 0}, scale = 0.0;
+    add_tangential_loads(st, d, nc, rinv, R_GRAIN, R_GRAIN, c.S.R, c.K, true, F, M1, M2, U);
+    for (int ch = 0; ch < NCHANNEL; ch++) {
+      Fs = Fs + load[ch].F1;
+      M1s = M1s + load[ch].M1;
+      M2s = M2s + load[ch].M2;
+      worst = std::max(worst, std::fabs(U[ch] - load[ch].U) / (std::fabs(load[ch].U) + 1e-300));
+      scale = std::max({scale, norm(load[ch].M1), norm(load[ch].M2)});
+    }
+    worst = std::max({worst, norm(F - Fs) / norm(Fs), norm(M1 - M1s) / scale,
+                      norm(M2 - M2s) / scale});
+  }
+  check(worst < 1e-14, "loads summed in one pass = the channels' loads summed (relative)",
+        worst, 0.0, 1e-14);
+}
+
 int main()
 {
   force_against_eq5();
@@ -274,6 +324,7 @@ int main()
   setup_changes_nothing();
   angular_momentum();
   elastic_oscillation();
+  fast_forms();
   std::printf("%d failed\n", failures);
   return failures;
 }
