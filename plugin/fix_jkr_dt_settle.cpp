@@ -27,9 +27,7 @@ using namespace LAMMPS_NS;
 
 FixJKRDTSettle::FixJKRDTSettle(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), window(5), tolerance(0.01), counts(1.0e-4), cap(-1.0), state(RUNNING), last_check(-1),
-    now{0, 0, 0, 0.0}, depart(DEPART_NO), departed_bit(0), moving_bits(0), quiet_speed(0.0),
-    break_energy(0.0), departed_grains(0.0), departed_fragments(0.0), table_append(false),
-    table(nullptr), table_start(0.0)
+    now{0, 0, 0, 0.0}, departure(lmp), table_append(false)
 {
   const char *usage = "fix ID all jkr/dt/settle N window K tolerance f [counts c] [cap T] "
                       "[depart yes|no|shadow] [table FILE] [append yes|no]";
@@ -59,9 +57,9 @@ FixJKRDTSettle::FixJKRDTSettle(LAMMPS *lmp, int narg, char **arg) :
       if (!(cap > 0.0)) error->all(FLERR, "fix jkr/dt/settle: cap is a simulated time > 0");
     } else if (key == "depart") {
       const std::string how = arg[iarg + 1];
-      if (how == "yes") depart = DEPART_YES;
-      else if (how == "no") depart = DEPART_NO;
-      else if (how == "shadow") depart = DEPART_SHADOW;
+      if (how == "yes") departure.mode = SettleDeparture::YES;
+      else if (how == "no") departure.mode = SettleDeparture::NO;
+      else if (how == "shadow") departure.mode = SettleDeparture::SHADOW;
       else error->all(FLERR, "fix jkr/dt/settle: depart is yes, no or shadow (got '{}')", how);
     } else if (key == "table") {
       table_path = arg[iarg + 1];
@@ -72,7 +70,7 @@ FixJKRDTSettle::FixJKRDTSettle(LAMMPS *lmp, int narg, char **arg) :
     }
   }
   if (cap > 0.0) cap += simulated_time();    // the cap counts from the fix's definition
-  open_table();
+  if (!table_path.empty()) table.reset(new SettleTable(lmp, table_path, table_append));
   restart_global = 1;
   vector_flag = 1;
   size_vector = 7;
@@ -82,7 +80,6 @@ FixJKRDTSettle::FixJKRDTSettle(LAMMPS *lmp, int narg, char **arg) :
 
 FixJKRDTSettle::~FixJKRDTSettle()
 {
-  if (table) fclose(table);
 }
 
 int FixJKRDTSettle::setmask()
@@ -93,8 +90,8 @@ int FixJKRDTSettle::setmask()
 void FixJKRDTSettle::post_constructor()
 {
   // the group exists before the pair style's init looks for it
-  if (depart == DEPART_YES) {
-    departed_bit = group->bitmask[group->find_or_create(PairJKRDT::DEPARTED_GROUP)];
+  if (departure.mode == SettleDeparture::YES) {
+    departure.departed_bit = group->bitmask[group->find_or_create(PairJKRDT::DEPARTED_GROUP)];
     force_reneighbor = 1;    // a departure reaches the ghost atoms' masks at the next step
     next_reneighbor = -1;
   }
@@ -104,12 +101,12 @@ void FixJKRDTSettle::init()
 {
   auto *pair = PairJKRDT::active(lmp);
   if (!pair) error->all(FLERR, "fix jkr/dt/settle requires pair_style jkr/dt");
-  if (depart == DEPART_NO) return;
+  if (departure.mode == SettleDeparture::NO) return;
   double lightest;
-  break_energy = pair->weakest_contact(lightest);
-  quiet_speed = std::sqrt(break_energy / lightest);
-  if (depart != DEPART_YES) return;
-  moving_bits = 0;
+  departure.break_energy = pair->weakest_contact(lightest);
+  departure.quiet_speed = std::sqrt(departure.break_energy / lightest);
+  if (departure.mode != SettleDeparture::YES) return;
+  departure.moving_bits = 0;
   for (const auto *fix : modify->get_fix_list()) {
     if (!fix->time_integrate) continue;
     if (fix->igroup == 0)
@@ -118,7 +115,7 @@ void FixJKRDTSettle::init()
                  "fragments would keep moving; integrate a group of its own instead "
                  "('group moving subtract all {}' and 'fix {} moving {}')",
                  fix->id, PairJKRDT::DEPARTED_GROUP, fix->id, fix->style);
-    moving_bits |= fix->groupbit;
+    departure.moving_bits |= fix->groupbit;
   }
 }
 
@@ -141,12 +138,6 @@ void FixJKRDTSettle::setup(int)
    fragments of the whole system: union-find over the bonded contacts of
    all ranks, each contact taken once (from the atom with the smaller ID)
 ------------------------------------------------------------------------- */
-
-int FixJKRDTSettle::Graph::root(int k)
-{
-  while (parent[k] != k) k = parent[k] = parent[parent[k]];
-  return k;
-}
 
 FixJKRDTSettle::Partition FixJKRDTSettle::partition(Graph &graph) const
 {
@@ -198,6 +189,13 @@ FixJKRDTSettle::Partition FixJKRDTSettle::partition(Graph &graph) const
   return p;
 }
 
+void FixJKRDTSettle::write_check(Graph &graph)
+{
+  if (table)
+    table->write(graph, {simulated_time(), now.n_fragments, now.contacts,
+                         departure.departed_grains, departure.departed_fragments});
+}
+
 double FixJKRDTSettle::simulated_time() const
 {
   return update->atime + (update->ntimestep - update->atimestep) * update->dt;
@@ -236,7 +234,11 @@ void FixJKRDTSettle::end_of_step()
   // the cap is met when the next check would lie beyond it
   if (reason == RUNNING && cap > 0.0 && simulated_time() + 0.5 * nevery * update->dt > cap)
     reason = CAP;
-  if (reason == RUNNING && depart != DEPART_NO) find_departures(graph);
+  if (reason == RUNNING && departure.mode != SettleDeparture::NO) {
+    const FixJKRDTContacts *C = PairJKRDT::active(lmp)->contacts();
+    if (departure.find(graph, C->npartner, simulated_time()))
+      next_reneighbor = update->ntimestep + 1;
+  }
   write_check(graph);
   if (reason != RUNNING) stop(reason);
 }
@@ -266,8 +268,8 @@ double FixJKRDTSettle::compute_vector(int n)
     case 2: return static_cast<double>(now.n_fragments);
     case 3: return static_cast<double>(now.contacts);
     case 4: return static_cast<double>(last_check);
-    case 5: return departed_grains;
-    default: return departed_fragments;
+    case 5: return departure.departed_grains;
+    default: return departure.departed_fragments;
   }
 }
 

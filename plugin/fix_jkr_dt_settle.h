@@ -52,22 +52,19 @@
 
 #include "fix.h"
 
-#include <cstdio>
+#include "fix_jkr_dt_settle_depart.h"
+#include "fix_jkr_dt_settle_table.h"
+#include "jkr_dt_fragments.h"
+
 #include <deque>
+#include <memory>
 #include <string>
-#include <unordered_map>
-#include <unordered_set>
-#include <vector>
 
 namespace LAMMPS_NS {
 
 class FixJKRDTSettle : public Fix {
  public:
   enum State { RUNNING = 0, SETTLED, CAP };
-  enum Depart { DEPART_NO = 0, DEPART_YES, DEPART_SHADOW };
-  // the per-atom custom vector that, where a deck defines it, receives each departed
-  // grain's time of departure (s): fix ID all property/atom d_departed_at
-  static constexpr const char *DEPARTED_AT = "departed_at";
   struct Partition {
     bigint n_largest, n_fragments, contacts;
     double dissipated;    // all channels of the contact fix's ledger, summed over ranks
@@ -95,28 +92,13 @@ class FixJKRDTSettle : public Fix {
   Partition now;
   std::deque<Partition> history;    // the last K + 1 checks
 
-  // the fragments: union-find over the bonded contacts of all ranks, the same on every
-  // rank; atoms without contacts are not nodes (single grains)
-  struct Graph {
-    std::unordered_map<tagint, int> index;    // atom ID -> node
-    std::vector<int> parent, size;
-    std::vector<tagint> edges;                // the bonded contacts, as pairs of atom IDs
-    int root(int k);
-  };
+  using Graph = FragmentGraph;    // the fragments (jkr_dt_fragments.h)
   Partition partition(Graph &graph) const;
-  int depart;                    // Depart
-  int departed_bit, moving_bits; // the departed group's bit; the integrators' groups' bits
-  double quiet_speed;            // a grain this fast against its fragment can break a contact
-  double break_energy;           // E_break of the weakest contact
-  double departed_grains, departed_fragments;
-  std::unordered_set<tagint> shadowed;    // fragments reported by depart shadow
-  void find_departures(Graph &graph);
+  SettleDeparture departure;     // depart yes|no|shadow (fix_jkr_dt_settle_depart.*)
   double simulated_time() const;
   std::string table_path;        // the in-run table; empty: none
   bool table_append;
-  FILE *table;
-  double table_start;            // wall-clock time the fix was defined
-  void open_table();
+  std::unique_ptr<SettleTable> table;    // (fix_jkr_dt_settle_table.*)
   void write_check(Graph &graph);
   void stop(int reason);
 };

@@ -29,10 +29,9 @@
    with depart shadow against runs that keep every fragment moving
    (validation/departure.py).                                              */
 
-#include "fix_jkr_dt_settle.h"
+#include "fix_jkr_dt_settle_depart.h"
 
 #include "fix_jkr_dt_contacts.h"
-#include "pair_jkr_dt.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -100,7 +99,7 @@ bool never_meet(const double p[3], const double q[3], double reach, double u)
 
 }    // namespace
 
-void FixJKRDTSettle::find_departures(Graph &graph)
+bool SettleDeparture::find(FragmentGraph &graph, const int *npartner, double now)
 {
   const int nlocal = atom->nlocal;
   int *mask = atom->mask;
@@ -220,13 +219,11 @@ void FixJKRDTSettle::find_departures(Graph &graph)
   // rank's, grouped by fragment: x, v, r. A grain whose kinetic energy against its
   // fragment's rigid motion is below E_break per contact it holds cannot break them
   // all: it stays bound, inside its fragment's sphere
-  auto *pair = PairJKRDT::active(lmp);
-  const FixJKRDTContacts *C = pair->contacts();
   std::vector<double> mine_grains;
   for (int i = 0; i < nlocal; i++) {
     const int b = body[i];
     if (b < 0 || B[b].departed) continue;
-    if (0.5 * rmass[i] * internal_speed2[i] <= C->npartner[i] * break_energy) continue;
+    if (0.5 * rmass[i] * internal_speed2[i] <= npartner[i] * break_energy) continue;
     const double *x = &xu[3 * i];
     mine_grains.insert(mine_grains.end(),
                        {(double) b, x[0], x[1], x[2], v[i][0], v[i][1], v[i][2], radius[i]});
@@ -321,14 +318,14 @@ void FixJKRDTSettle::find_departures(Graph &graph)
     if (!leaves_all[b]) continue;
     n_frag++;
     n_grains += B[b].n;
-    if (depart == DEPART_SHADOW && shadowed.insert(B[b].label).second && comm->me == 0)
+    if (mode == SHADOW && shadowed.insert(B[b].label).second && comm->me == 0)
       utils::logmesg(lmp, "jkr/dt/settle: would depart step {} label {} size {}\n",
                      update->ntimestep, B[b].label, B[b].n);
   }
-  if (depart != DEPART_YES) return;
+  if (mode != YES) return false;
   departed_grains = gone_grains + n_grains;
   departed_fragments = gone_frags + n_frag;
-  if (n_frag == 0) return;
+  if (n_frag == 0) return false;
   // grains of fragments with contacts by their body; single grains by their ID
   std::unordered_map<tagint, int> single_leaves;
   for (int b = M; b < F; b++)
@@ -338,7 +335,6 @@ void FixJKRDTSettle::find_departures(Graph &graph)
   int flag, cols;
   const int slot = atom->find_custom(DEPARTED_AT, flag, cols);
   double *departed_at = (slot >= 0 && flag == 1 && cols == 0) ? atom->dvector[slot] : nullptr;
-  const double now = simulated_time();
   for (int i = 0; i < nlocal; i++) {
     const bool go = body[i] >= 0 ? leaves_all[body[i]] != 0 : single_leaves.count(tag[i]) > 0;
     if (!go) continue;
@@ -346,10 +342,10 @@ void FixJKRDTSettle::find_departures(Graph &graph)
     mask[i] &= ~moving_bits;
     if (departed_at) departed_at[i] = now;
   }
-  next_reneighbor = update->ntimestep + 1;
   if (comm->me == 0)
     utils::logmesg(lmp,
                    "jkr/dt/settle: departed step {} fragments {} grains {} (so far {} "
                    "fragments, {} grains)\n",
                    update->ntimestep, n_frag, n_grains, departed_fragments, departed_grains);
+  return true;
 }

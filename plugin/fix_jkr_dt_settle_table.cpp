@@ -27,7 +27,7 @@
    rows, and one continued from a restart file appends rows for steps that
    may already be there (the later row is the one that counts).             */
 
-#include "fix_jkr_dt_settle.h"
+#include "fix_jkr_dt_settle_table.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -44,23 +44,27 @@
 
 using namespace LAMMPS_NS;
 
-void FixJKRDTSettle::open_table()
+SettleTable::SettleTable(LAMMPS *lmp, const std::string &path_, bool append) :
+    Pointers(lmp), path(path_), file(nullptr), start(platform::walltime())
 {
-  table_start = platform::walltime();
-  if (table_path.empty() || comm->me != 0) return;
-  table = fopen(table_path.c_str(), table_append ? "a" : "w");
-  if (!table)
+  if (comm->me != 0) return;
+  file = fopen(path.c_str(), append ? "a" : "w");
+  if (!file)
     error->one(FLERR, "fix jkr/dt/settle: cannot write the table {}: {}; check that its "
-               "directory exists and is writable", table_path, utils::getsyserror());
-  if (ftell(table) == 0)
+               "directory exists and is writable", path, utils::getsyserror());
+  if (ftell(file) == 0)
     fputs("step,time,n_total,n_largest,n_second,n_fragments,contacts,contacts_largest,"
           "gyration_radius_largest,N_cum_1,N_cum_4,N_cum_16,departed_grains,"
-          "departed_fragments,wall,memory_mb,peak_rss_mb\n", table);
+          "departed_fragments,wall,memory_mb,peak_rss_mb\n", file);
 }
 
-void FixJKRDTSettle::write_check(Graph &graph)
+SettleTable::~SettleTable()
 {
-  if (table_path.empty()) return;
+  if (file) fclose(file);
+}
+
+void SettleTable::write(FragmentGraph &graph, const Check &check)
+{
   // the fragments of more than one grain: their sizes and smallest atom IDs, by root
   const int nodes = static_cast<int>(graph.parent.size());
   std::vector<tagint> smallest(nodes, -1);
@@ -118,11 +122,12 @@ void FixJKRDTSettle::write_check(Graph &graph)
   Info(lmp).get_memory_info(memory);    // MB: LAMMPS's count, the heap, the peak resident size
   memory[1] = memory[2];
   MPI_Allreduce(memory, largest_memory, 2, MPI_DOUBLE, MPI_MAX, world);
-  if (comm->me != 0 || !table) return;
-  fmt::print(table,
+  if (comm->me != 0 || !file) return;
+  fmt::print(file,
              "{},{:.17g},{},{},{},{},{},{},{:.17g},{},{},{},{:.17g},{:.17g},{:.6g},{:.6g},{:.6g}\n",
-             update->ntimestep, simulated_time(), atom->natoms, first, second, now.n_fragments,
-             now.contacts, inside, rg, singles, cum4, cum16, departed_grains, departed_fragments,
-             platform::walltime() - table_start, largest_memory[0], largest_memory[1]);
-  fflush(table);
+             update->ntimestep, check.time, atom->natoms, first, second, check.n_fragments,
+             check.contacts, inside, rg, singles, cum4, cum16, check.departed_grains,
+             check.departed_fragments, platform::walltime() - start, largest_memory[0],
+             largest_memory[1]);
+  fflush(file);
 }

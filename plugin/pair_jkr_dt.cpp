@@ -280,7 +280,7 @@ void PairJKRDT::compute(int eflag, int vflag)
   for (int t = 0; t < nthreads; t++) {
     Accumulator &a = acc[t];
     a.thread = t;
-    a.thread_of = nthreads > 1 ? thread_of.data() : nullptr;
+    a.thread_of = nullptr;    // set below when threaded
     a.far.clear();
     a.upot = a.eng = a.step_max = 0.0;
     a.contact_ends = 0;
@@ -299,16 +299,22 @@ void PairJKRDT::compute(int eflag, int vflag)
   if (nthreads == 1) {
     loop(0, inum, tally_atoms, acc[0]);
   } else {
-    if ((int) thread_of.size() < atom->nlocal) thread_of.resize(atom->nmax);
+    // the atoms' threads follow the list: set when it is built (or the thread count changes)
+    auto from = [&](int t) { return (int) ((bigint) inum * t / nthreads); };
+    if (thread_of_build != neighbor->lastcall || thread_of_threads != nthreads ||
+        (int) thread_of.size() < atom->nlocal) {
+      if ((int) thread_of.size() < atom->nlocal) thread_of.resize(atom->nmax);
+      for (int t = 0; t < nthreads; t++)
+        for (int ii = from(t); ii < from(t + 1); ii++) thread_of[list->ilist[ii]] = t;
+      thread_of_build = neighbor->lastcall;
+      thread_of_threads = nthreads;
+    }
+    for (int t = 0; t < nthreads; t++) acc[t].thread_of = thread_of.data();
 #if defined(_OPENMP)
 #pragma omp parallel num_threads(nthreads)
     {
       const int t = omp_get_thread_num();
-      const int from = (int) ((bigint) inum * t / nthreads);
-      const int to = (int) ((bigint) inum * (t + 1) / nthreads);
-      for (int ii = from; ii < to; ii++) thread_of[list->ilist[ii]] = t;
-#pragma omp barrier
-      loop(from, to, false, acc[t]);
+      loop(from(t), from(t + 1), false, acc[t]);
     }
 #endif
     // what each thread added to other threads' atoms, in thread order: the same

@@ -189,7 +189,9 @@ class PairJKRDT : public Pair {
                  Accumulator &acc);
   [[noreturn]] void report(const Trouble &t) const;
   int nthreads_used() const;
-  std::vector<int> thread_of;         // owning thread of each owned atom (threaded runs)
+  std::vector<int> thread_of;         // owning thread of each owned atom (threaded runs) ...
+  bigint thread_of_build = -1;        // ... for the list of this build
+  int thread_of_threads = 0;          // ... and this many threads
   std::vector<Accumulator> accumulators;
   int threads_logged;          // threads per rank last written to the log
   void fill_pvector(double upot, const double *utan, double contacts);

@@ -1,0 +1,38 @@
+/* jkr/dt: the in-run table of fix jkr/dt/settle (table FILE): one CSV row
+   per check of the fragments it has found (fix_jkr_dt_settle_table.cpp has
+   the columns). Rank 0 writes; every rank takes part in a row.             */
+
+#ifndef JKR_DT_FIX_SETTLE_TABLE_H
+#define JKR_DT_FIX_SETTLE_TABLE_H
+
+#include "pointers.h"
+
+#include "jkr_dt_fragments.h"
+
+#include <cstdio>
+#include <string>
+
+namespace LAMMPS_NS {
+
+class SettleTable : protected Pointers {
+ public:
+  // what the check knows beyond the fragments
+  struct Check {
+    double time;                                 // simulated time, s
+    bigint n_fragments, contacts;
+    double departed_grains, departed_fragments;    // so far
+  };
+  // opens FILE on rank 0 (append: add to it) and starts the wall clock of the table
+  SettleTable(class LAMMPS *lmp, const std::string &path, bool append);
+  ~SettleTable() override;
+  void write(FragmentGraph &graph, const Check &check);    // collective
+
+ private:
+  std::string path;
+  FILE *file;
+  double start;    // wall-clock time the table was opened
+};
+
+}    // namespace LAMMPS_NS
+
+#endif
