@@ -34,7 +34,8 @@ FixJKRDTContacts::FixJKRDTContacts(LAMMPS *lmp, int narg, char **arg) :
     error->all(FLERR,
                "fix jkr/dt/contacts is created by pair_style jkr/dt; do not define it by hand");
   mask = utils::inumeric(FLERR, arg[3], false, lmp);
-  dnum = layout_size(mask, field_offset);
+  state = JKRDT::state_layout(mask);
+  dnum = state.dnum;
 
   restart_global = 1;
   restart_peratom = 1;
@@ -107,7 +108,7 @@ void FixJKRDTContacts::check_atoms(bigint natoms_before)
   for (size_t e = 0; e < flat.size(); e += 2) renamed.emplace_back(flat[e], flat[e + 1]);
   std::sort(renamed.begin(), renamed.end());
 
-  const int off_n = has_field(POINTERS) ? offset(POINTERS) : -1;
+
   bigint removed = 0, all_removed = 0;
   for (int i = 0; i < nlocal; i++) {
     for (int k = npartner[i] - 1; k >= 0; k--) {
@@ -120,10 +121,7 @@ void FixJKRDTContacts::check_atoms(bigint natoms_before)
         continue;
       }
       const tagint now = it->second;
-      if (off_n >= 0 && (owner[i] < was) != (tag[i] < now)) {
-        double *n = contact_values(i, k) + off_n;
-        std::swap_ranges(n, n + 3, n + 3);
-      }
+      if ((owner[i] < was) != (tag[i] < now)) JKRDT::swap_particles(contact_values(i, k), state);
       partner[i][k] = now;
     }
     owner[i] = tag[i];
@@ -206,48 +204,27 @@ void FixJKRDTContacts::post_run()
 }
 
 /* ----------------------------------------------------------------------
-   offsets of the fields present in a layout mask; returns doubles per contact
-------------------------------------------------------------------------- */
-
-int FixJKRDTContacts::layout_size(int layout, int *offsets)
-{
-  int n = 0;
-  for (int f = 0; f < NFIELD; f++) {
-    offsets[f] = -1;
-    if ((layout >> f) & 1) {
-      offsets[f] = n;
-      n += FIELD_SIZE[f];
-    }
-  }
-  return n;
-}
-
-/* ----------------------------------------------------------------------
    switch to a new set of fields, keeping the values of fields in both
 ------------------------------------------------------------------------- */
 
 void FixJKRDTContacts::set_layout(int newmask)
 {
   if (newmask == mask) return;
-  int newoffset[NFIELD];
-  const int newdnum = layout_size(newmask, newoffset);
+  const JKRDT::StateLayout next = JKRDT::state_layout(newmask);
+  const int newdnum = next.dnum;
   const int nmax = nmax_alloc;
 
   double **newvalues = nullptr;
   if (newdnum > 0) memory->create(newvalues, nmax, maxpartner * newdnum, "jkr/dt:values");
-  for (int i = 0; i < atom->nlocal; i++)
-    for (int k = 0; k < npartner[i]; k++) {
-      double *dst = newvalues ? newvalues[i] + k * newdnum : nullptr;
-      if (dst) std::fill(dst, dst + newdnum, 0.0);
-      for (int f = 0; f < NFIELD; f++)
-        if (newoffset[f] >= 0 && field_offset[f] >= 0)
-          std::copy_n(values[i] + k * dnum + field_offset[f], FIELD_SIZE[f], dst + newoffset[f]);
-    }
+  for (int i = 0; i < atom->nlocal && newvalues; i++)
+    for (int k = 0; k < npartner[i]; k++)
+      JKRDT::relayout(values ? values[i] + k * dnum : nullptr, state, newvalues[i] + k * newdnum,
+                      next);
   memory->destroy(values);
   values = newvalues;
   mask = newmask;
+  state = next;
   dnum = newdnum;
-  std::copy_n(newoffset, NFIELD, field_offset);
   set_exchange_size();
 }
 
@@ -542,20 +519,15 @@ void FixJKRDTContacts::unpack_restart(int nlocal, int nth)
   const double *record = extra[nlocal] + m;
   const double *buf = record + 1;
 
-  const int filemask = static_cast<int>(*buf++);
-  int fileoffset[NFIELD];
-  const int filednum = layout_size(filemask, fileoffset);
+  const JKRDT::StateLayout file = JKRDT::state_layout(static_cast<int>(*buf++));
+  const int filednum = file.dnum;
   const int n = static_cast<int>(*buf++);
   grow_partner_capacity(n);
   npartner[nlocal] = n;
   for (int k = 0; k < n; k++) partner[nlocal][k] = (tagint) ubuf(*buf++).i;
   for (int k = 0; k < n; k++, buf += filednum) {
     if (!dnum) continue;
-    double *dst = values[nlocal] + k * dnum;
-    std::fill(dst, dst + dnum, 0.0);
-    for (int f = 0; f < NFIELD; f++)
-      if (field_offset[f] >= 0 && fileoffset[f] >= 0)
-        std::copy_n(buf + fileoffset[f], FIELD_SIZE[f], dst + field_offset[f]);
+    JKRDT::relayout(buf, file, values[nlocal] + k * dnum, state);
   }
   for (int l = 0; l < NLEDGER; l++) ledger[nlocal][l] = *buf++;
   // files written before the owner ID was stored end here: their IDs are the atoms' own

@@ -24,11 +24,14 @@
    a pair_style command that replaces jkr/dt, and then refuses to run while
    it holds contacts (they would go stale); pair_style jkr/dt takes them back.
 
-   Per-contact values are laid out by "fields" that the pair style switches
-   on only when some type pair needs them, so a channel that is off stores
-   nothing. Values of a contact are kept in the canonical orientation of the
-   pair (the atom with the smaller ID is "particle 1"), so both copies are
-   identical.
+   Per-contact values are laid out by "fields" that the kernel declares
+   (StateField in jkr_dt_contact.h) and the pair style switches on only when
+   some type pair needs them, so a channel that is off stores nothing. This
+   fix moves the values without reading them: the kernel says how they map
+   from one set of fields to another (relayout) and what a swap of the
+   particles does to them (swap_particles). Values of a contact are kept in
+   the canonical orientation of the pair (the atom with the smaller ID is
+   "particle 1"), so both copies are identical.
 
    The fix's global scalar is the number of doubles stored per contact under
    the current layout (0 for the frictionless model).
@@ -64,13 +67,6 @@ class FixJKRDTContacts : public Fix {
     std::function<void()> on_lost_contact;    // a stored contact left the list: say why, stop
   } writer;
 
-  // per-contact value fields, each present only when its bit is in the layout mask:
-  //   DAMPING_FORCE  F_D of eq. (A.5) at the last step          (tvis > 0)
-  //   POINTERS       contact pointers n1, n2, section 2.2.4      (sliding or rolling)
-  //   TWIST          twisting angle phi, eq. (24)                (twisting)
-  enum Field { DAMPING_FORCE = 0, POINTERS, TWIST, NFIELD };
-  static constexpr int FIELD_SIZE[NFIELD] = {1, 6, 1};
-
   // ledger columns: energy dissipated by channel, the kernel's loss channels
   enum Ledger {
     FORM_BREAK = JKRDT::LOSS_FORM_BREAK,
@@ -97,14 +93,10 @@ class FixJKRDTContacts : public Fix {
   void post_run() override;
   double compute_scalar() override { return dnum; }    // doubles stored per contact
 
+  // the fields stored per contact (a mask of the kernel's StateFields, jkr_dt_contact.h)
   void set_layout(int mask);
   int layout_mask() const { return mask; }
-  bool has_field(Field f) const { return (mask >> f) & 1; }
-  int offset(Field f) const { return field_offset[f]; }
-  JKRDT::StateLayout layout() const
-  {
-    return {field_offset[DAMPING_FORCE], field_offset[POINTERS], field_offset[TWIST], dnum};
-  }
+  JKRDT::StateLayout layout() const { return state; }
 
   // list-order state: slot s of the pair loop (running over ilist, then each
   // atom's neighbors) is bonded if bonded[s], with values slot_values + s * dnum
@@ -152,7 +144,7 @@ class FixJKRDTContacts : public Fix {
 
  private:
   int mask;             // bit f set = field f stored
-  int field_offset[NFIELD];
+  JKRDT::StateLayout state;    // where the fields sit among a contact's dnum values
   int maxpartner;       // row capacity of partner/values on this rank
   int nmax_alloc;       // rows allocated in the per-atom arrays
 
@@ -165,7 +157,6 @@ class FixJKRDTContacts : public Fix {
   bool rows_stale;                  // the slots hold state the rows do not
   int slot_nlocal;                  // owned atoms when the slots were filled ...
   std::vector<tagint> slot_tag;     // ... and the IDs of all atoms then, owned and ghost
-  static int layout_size(int mask, int *offsets);
 };
 
 }    // namespace LAMMPS_NS

@@ -116,6 +116,68 @@ struct StateLayout {
   int dnum = 0;         // values per contact
 };
 
+/* ----------------------------------------------------------------------
+   the per-contact state, declared once: the fields a contact can store,
+   their sizes, which fields a type pair's coefficients need, and where
+   they sit among a contact's values when a set of fields (a mask, one bit
+   per field) is stored. The contact fix stores the values without knowing
+   what they are; the kernel and the pair read them through a StateLayout.
+     FIELD_DAMPING_FORCE  F_D of eq. (A.5) at the last step     (tvis > 0)
+     FIELD_POINTERS       the contact pointers n1, n2, sec. 2.2.4 (sliding or rolling)
+     FIELD_TWIST          the twisting angle phi, eq. (24)      (twisting)
+------------------------------------------------------------------------- */
+
+enum StateField { FIELD_DAMPING_FORCE = 0, FIELD_POINTERS, FIELD_TWIST, NFIELD };
+constexpr int FIELD_SIZE[NFIELD] = {1, 6, 1};
+
+inline int state_fields(const Coefficients &P)
+{
+  int mask = 0;
+  if (P.damp_coef > 0.0) mask |= 1 << FIELD_DAMPING_FORCE;
+  if (P.sliding || P.rolling) mask |= 1 << FIELD_POINTERS;
+  if (P.twisting) mask |= 1 << FIELD_TWIST;
+  return mask;
+}
+
+inline StateLayout state_layout(int mask)
+{
+  int offset[NFIELD], n = 0;
+  for (int f = 0; f < NFIELD; f++) {
+    offset[f] = ((mask >> f) & 1) ? n : -1;
+    if (offset[f] >= 0) n += FIELD_SIZE[f];
+  }
+  return {offset[FIELD_DAMPING_FORCE], offset[FIELD_POINTERS], offset[FIELD_TWIST], n};
+}
+
+inline int field_offset(const StateLayout &L, int field)
+{
+  return field == FIELD_DAMPING_FORCE ? L.fd : field == FIELD_POINTERS ? L.pointers : L.phi;
+}
+
+// a contact's values stored under layout a, written under layout b: the fields both
+// store are copied, the others are 0
+inline void relayout(const double *from, const StateLayout &a, double *to, const StateLayout &b)
+{
+  for (int k = 0; k < b.dnum; k++) to[k] = 0.0;
+  for (int f = 0; f < NFIELD; f++) {
+    const int src = field_offset(a, f), dst = field_offset(b, f);
+    if (src >= 0 && dst >= 0)
+      for (int k = 0; k < FIELD_SIZE[f]; k++) to[dst + k] = from[src + k];
+  }
+}
+
+// the contact's particles swap roles (the order of their IDs changed): n1 <-> n2; F_D
+// and phi ((omega1 - omega2) . n_c) stay as they are
+inline void swap_particles(double *values, const StateLayout &L)
+{
+  if (L.pointers < 0) return;
+  for (int k = 0; k < 3; k++) {
+    const double t = values[L.pointers + k];
+    values[L.pointers + k] = values[L.pointers + 3 + k];
+    values[L.pointers + 3 + k] = t;
+  }
+}
+
 // the stored tangential state; false if the pointers were never set (a
 // contact formed while no channel needed them)
 inline bool load_state(const double *values, const StateLayout &L, ContactState &c)

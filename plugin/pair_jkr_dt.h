@@ -1,12 +1,17 @@
 /* jkr/dt: pair style for the contact model of Dominik & Tielens made
    energy-conserving by Wada et al. (2007).
 
-   This class is the LAMMPS glue: coefficients and their mixing
-   (pair_jkr_dt_coeff.cpp), bins that grow with the box (pair_jkr_dt_bins.cpp),
-   the neighbor-list loop, contact formation and
-   breaking, energy and dissipation bookkeeping (pair_jkr_dt.cpp). The
-   contact physics lives in jkr_dt_normal.h; the contact state in
-   FixJKRDTContacts.                                                        */
+   This class is the LAMMPS glue, in layers that call downward only:
+     pair_jkr_dt.cpp             its own state, the look-ups, the local view
+     pair_jkr_dt_init.cpp        init_style: checks, constants, the contact store
+     pair_jkr_dt_loop.cpp        the neighbor-list loop, contact formation and
+                                 breaking, energy and dissipation bookkeeping
+     pair_jkr_dt_coeff.cpp       the pair_coeff keywords, mixing, data and restart files
+     pair_jkr_dt_guards.cpp      t_c, the time-step limits, the errors of a run
+     pair_jkr_dt_bins.cpp        bins that grow with the box
+     pair_jkr_dt_tangential.cpp  a tangential channel switched off between runs
+   The contact physics lives in jkr_dt_contact.h (normal: jkr_dt_normal.h,
+   tangential: jkr_dt_tangential.h); the contact state in FixJKRDTContacts.  */
 
 #ifndef JKR_DT_PAIR_H
 #define JKR_DT_PAIR_H

@@ -2,7 +2,7 @@
 checks of tests/kernel/test_contact_kernel.cpp (force against eq. 5, the solver of eq. 4
 against Newton's method, the clamps of eqs. 36-38, a run's set-up changing nothing,
 angular momentum of one contact, energy of one elastic oscillation, the step's fast
-forms against the plain ones),
+forms against the plain ones, the per-contact state's layouts),
 compiled here with the compiler that built the plugin."""
 
 import os
@@ -31,4 +31,4 @@ def test_contact_kernel_checks(tmp_path):
     lines = run.stdout.splitlines()
     assert lines[-1] == "0 failed", run.stdout
     checks = [line for line in lines[:-1]]
-    assert len(checks) == 27 and all(line.startswith("ok ") for line in checks), run.stdout
+    assert len(checks) == 28 and all(line.startswith("ok ") for line in checks), run.stdout

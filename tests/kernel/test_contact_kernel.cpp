@@ -316,6 +316,31 @@ static void fast_forms()
         worst, 0.0, 1e-14);
 }
 
+// the per-contact state as the kernel declares it: a full frictional contact with damping
+// stores F_D, n1, n2 and phi (8 values); switching the channels off and on keeps the fields
+// both layouts have and zeroes the others; swapping the particles swaps n1 and n2 only
+static void state_layouts()
+{
+  Coefficients P = ice(true, true, true, 5e-12);
+  const StateLayout all = state_layout(state_fields(P));
+  P.sliding = P.rolling = P.twisting = 0;
+  const StateLayout damped = state_layout(state_fields(P));
+  const double v[8] = {1, 2, 3, 4, 5, 6, 7, 8};
+  double w[8], back[8];
+  relayout(v, all, w, damped);
+  relayout(w, damped, back, all);
+  const double want[8] = {1, 0, 0, 0, 0, 0, 0, 0};
+  int wrong = (all.dnum != 8) + (damped.dnum != 1);
+  for (int k = 0; k < 8; k++) wrong += back[k] != want[k];
+  double swapped[8];
+  std::copy(v, v + 8, swapped);
+  swap_particles(swapped, all);
+  const double want_swapped[8] = {1, 5, 6, 7, 2, 3, 4, 8};
+  for (int k = 0; k < 8; k++) wrong += swapped[k] != want_swapped[k];
+  check(wrong == 0, "state layouts: sizes, relayout both ways, particles swapped (values wrong)",
+        wrong, 0, 0);
+}
+
 int main()
 {
   force_against_eq5();
@@ -325,6 +350,7 @@ int main()
   angular_momentum();
   elastic_oscillation();
   fast_forms();
+  state_layouts();
   std::printf("%d failed\n", failures);
   return failures;
 }

@@ -1,0 +1,405 @@
+/* jkr/dt: the neighbor-list loop, contact formation and breaking, and the
+   energy ledger.
+
+   Parallel layout. The style asks for a half neighbor list built as with
+   newton off, whatever the global newton setting: a pair with one ghost atom
+   is computed on both ranks, and each rank writes forces and contact state
+   only for its own atoms. The contact state is kept in list order, one copy
+   per pair of this rank's list (FixJKRDTContacts): a pair with a ghost atom
+   is kept, and advanced identically, on both ranks, so no reverse
+   communication of contact state is ever needed. Each pair is
+   evaluated in its canonical orientation (particle 1 = smaller atom ID), so
+   the two ranks do the same arithmetic on the same numbers.
+
+   The tangential channels (sliding, rolling, twisting; section 2.2) of a
+   contact are advanced in pair_jkr_dt_tangential.cpp; their forces and
+   torques are added here.
+
+   Energy. pe holds the contact potentials U_n + U_s + U_r + U_t, eqs. (6),
+   (11), (21), (25). The energy that
+   leaves the mechanical budget is booked per channel in the contact fix's
+   per-atom ledger, half to each atom of the contact:
+     formation, breaking  the jump of U_n (section 2.1) as the integrator
+                meets it: see event_loss() in jkr_dt_normal.h
+     damping    the work of F_D of eq. (A.5) across the two half-kicks of
+                velocity Verlet that apply it: F_D(n) (v_rel(n-1/2) + v_rel(n+1/2)) dt / 2
+     sliding, rolling, twisting  the inelastic clamps of section 2.2.5 and
+                the springs' energy when a contact breaks
+   so that ke + erotate + pe + (dissipated) stays constant.
+   Contacts present when a run starts (the force evaluation of setup) are
+   taken as given: they book nothing.                                        */
+
+#include "pair_jkr_dt.h"
+
+#include "fix_jkr_dt_contacts.h"
+
+#include "atom.h"
+#include "comm.h"
+#include "error.h"
+#include "memory.h"
+#include "neigh_list.h"
+#include "neighbor.h"
+#include "update.h"
+
+#include <algorithm>
+#include <cmath>
+#if defined(_OPENMP)
+#include <omp.h>
+#endif
+
+using namespace LAMMPS_NS;
+using Contacts = FixJKRDTContacts;
+
+void PairJKRDT::compute(int eflag, int vflag)
+{
+  ev_init(eflag, vflag);
+  if (update->laststep != checked_laststep) {    // once per run, 'run N pre no' included
+    checked_laststep = update->laststep;
+    check_time_step();
+  }
+  Contacts &C = *fix_contacts;
+  if (!C.slots_follow(list)) C.to_slots(list);    // a list built without post_neighbor
+
+  const int inum = list->inum;
+  const bool tally_atoms = eflag_atom || vflag_atom;
+  const int nthreads = (tally_atoms || inum < 64) ? 1 : nthreads_used();
+  if ((int) accumulators.size() < nthreads) accumulators.resize(nthreads);
+  std::vector<Accumulator> &acc = accumulators;
+  for (int t = 0; t < nthreads; t++) {
+    Accumulator &a = acc[t];
+    a.thread = t;
+    a.thread_of = nullptr;    // set below when threaded
+    a.far.clear();
+    a.upot = a.eng = a.step_max = 0.0;
+    a.contact_ends = 0;
+    std::fill(a.utan, a.utan + JKRDT::NCHANNEL, 0.0);
+    std::fill(a.virial, a.virial + 6, 0.0);
+    a.trouble = Trouble();
+  }
+
+  const ConstantsBy by = constants_by();
+  auto loop = [&](int from, int to, bool tally, Accumulator &a) {
+    if (any_tangential)
+      pair_loop<true>(from, to, eflag, tally, by, a);
+    else
+      pair_loop<false>(from, to, eflag, tally, by, a);
+  };
+  if (nthreads == 1) {
+    loop(0, inum, tally_atoms, acc[0]);
+  } else {
+    // the atoms' threads follow the list: set when it is built (or the thread count changes)
+    auto from = [&](int t) { return (int) ((bigint) inum * t / nthreads); };
+    if (thread_of_build != neighbor->lastcall || thread_of_threads != nthreads ||
+        update->setupflag || (int) thread_of.size() < atom->nlocal) {
+      if ((int) thread_of.size() < atom->nlocal) thread_of.resize(atom->nmax);
+      for (int t = 0; t < nthreads; t++)
+        for (int ii = from(t); ii < from(t + 1); ii++) thread_of[list->ilist[ii]] = t;
+      thread_of_build = neighbor->lastcall;
+      thread_of_threads = nthreads;
+    }
+    for (int t = 0; t < nthreads; t++) acc[t].thread_of = thread_of.data();
+#if defined(_OPENMP)
+#pragma omp parallel num_threads(nthreads)
+    {
+      const int t = omp_get_thread_num();
+      loop(from(t), from(t + 1), false, acc[t]);
+    }
+#endif
+    // what each thread added to other threads' atoms, in thread order: the same
+    // partition gives the same sums
+    double **f = atom->f, **tq = atom->torque, **ledger = C.ledger;
+    for (int t = 0; t < nthreads; t++)
+      for (const FarLoad &l : acc[t].far) {
+        for (int k = 0; k < 3; k++) {
+          f[l.atom][k] += l.f[k];
+          tq[l.atom][k] += l.torque[k];
+        }
+        for (int k = 0; k < JKRDT::NLOSS; k++) ledger[l.atom][k] += l.loss[k];
+      }
+  }
+
+  Accumulator &total = acc[0];    // the other threads' sums go into thread 0's
+  for (int t = 0; t < nthreads; t++) {
+    if (acc[t].trouble.kind != Trouble::NONE) report(acc[t].trouble);
+    if (t == 0) continue;
+    total.upot += acc[t].upot;
+    total.contact_ends += acc[t].contact_ends;
+    total.eng += acc[t].eng;
+    total.step_max = std::max(total.step_max, acc[t].step_max);
+    for (int ch = 0; ch < JKRDT::NCHANNEL; ch++) total.utan[ch] += acc[t].utan[ch];
+    for (int k = 0; k < 6; k++) total.virial[k] += acc[t].virial[k];
+  }
+  step_max = std::max(step_max, total.step_max);
+  if (!tally_atoms) {
+    if (eflag_global) eng_vdwl += total.eng;
+    if (vflag_global)
+      for (int k = 0; k < 6; k++) virial[k] += total.virial[k];
+  }
+  C.rows_changed();
+  if (eflag_global) fill_pvector(total.upot, total.utan, 0.5 * total.contact_ends);
+}
+
+/* ----------------------------------------------------------------------
+   where the pair loop finds a contact's constants (contact_constants), as
+   the radii are now: one set for the scene when every type pair present
+   has the same constants and each type one radius, one per type pair when
+   each type has one radius, else from each pair's radii. The radii are
+   checked when the neighbor list is built (atoms arrive, ghosts change),
+   and at every step while a fix adapt, which changes them, is defined.
+------------------------------------------------------------------------- */
+
+PairJKRDT::ConstantsBy PairJKRDT::constants_by()
+{
+  if (!one_radius_per_type) return BY_RADII;
+  if (!radii_adapt && radii_checked == neighbor->lastcall && !update->setupflag)
+    return constants_source;
+  radii_checked = neighbor->lastcall;
+  const double *radius = atom->radius;
+  const int *type = atom->type;
+  const int nall = atom->nlocal + atom->nghost;
+  constants_source = scene_pair >= 0 ? BY_SCENE : BY_TYPE;
+  for (int k = 0; k < nall; k++)
+    if (radius[k] != minrad[type[k]]) constants_source = BY_RADII;
+  return constants_source;
+}
+
+/* ----------------------------------------------------------------------
+   the pair loop over ilist entries [ii_from, ii_to), in five steps per
+   pair: the distance test (all that a pair out of contact costs), the
+   orientation and constants, the motion and its guards, contact_step(),
+   and the loads and dissipation on this thread's owned atoms. TANGENTIAL:
+   some type pair has a tangential channel.
+
+   Orientation. The tangential state is kept for particle 1 = the smaller
+   ID, so a contact with a channel is evaluated in that orientation. The
+   normal force needs no orientation: swapping the atoms negates d12 and
+   v12 exactly and leaves every product the same, so without channels the
+   pair is taken as the list gives it and the same bits result.
+------------------------------------------------------------------------- */
+
+template <bool TANGENTIAL>
+void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, ConstantsBy by,
+                          Accumulator &acc)
+{
+  using JKRDT::V3;
+  // LAMMPS's per-atom 3-vectors are contiguous: index them flat, one load less per neighbor
+  const double *const x = atom->x[0];
+  const double *const v = atom->v[0];
+  const double *const omega = atom->omega[0];
+  const double *radius = atom->radius;
+  const tagint *tag = atom->tag;
+  const int *type = atom->type;
+  const int *mask = atom->mask;
+  const int departed = departed_bit;
+  const int nlocal = atom->nlocal;
+  const bool run_setup = update->setupflag;
+  const double dt = update->dt;
+  const double half_skin = 0.5 * neighbor->skin;
+  double **f = atom->f, **tq = atom->torque, **ledger = fix_contacts->ledger;
+  // an owned atom of another thread gets its share through acc.far
+  const int *thread_of_atom = acc.thread_of;
+  const int me = acc.thread;
+
+  Contacts &C = *fix_contacts;
+  const JKRDT::StateLayout layout = C.layout();
+  unsigned char *const bonded_slot = C.bonded;
+  double *const slot_values = C.slot_values;
+  const int *ilist = list->ilist;
+  const int *numneigh = list->numneigh;
+  int **firstneigh = list->firstneigh;
+
+  const JKRDT::ContactConstants *const scene_K =
+      by == BY_SCENE ? &type_constants[scene_pair] : nullptr;
+  JKRDT::ContactConstants cached{};    // BY_RADII: the last pair's, reused while they fit
+  const Param *last_param = nullptr;
+  double last_r1 = -1.0, last_r2 = -1.0;
+  auto constants = [&](int p, int q) -> const JKRDT::ContactConstants & {
+    if (by == BY_SCENE) return *scene_K;
+    if (by == BY_TYPE) return type_constants[type[p] * nstride + type[q]];
+    const Param &P = par(type[p], type[q]);
+    if (&P != last_param || radius[p] != last_r1 || radius[q] != last_r2) {
+      cached = JKRDT::contact_constants(P, radius[p], radius[q]);
+      last_param = &P;
+      last_r1 = radius[p];
+      last_r2 = radius[q];
+    }
+    return cached;
+  };
+  auto trouble = [&](Trouble::Kind kind, int p, int q, double a, double b,
+                     const JKRDT::ContactConstants &K) {
+    if (tag[q] < tag[p]) std::swap(p, q);    // name the pair as the other rank does
+    acc.trouble = {kind, p, q, a, b, K.S};
+  };
+  JKRDT::ContactResult out;
+
+  for (int ii = ii_from; ii < ii_to; ii++) {
+    const int i = ilist[ii];
+    const int *jlist = firstneigh[i];
+    const int jnum = numneigh[i];
+    const V3 xi = JKRDT::vec(x + 3 * i);
+    int s = C.slot_first[ii];
+    for (int jj = 0; jj < jnum; jj++, s++) {
+      const int j = jlist[jj] & NEIGHMASK;
+
+      // 1. the distance test
+      const bool bonded = bonded_slot[s];
+      V3 d12 = xi - JKRDT::vec(x + 3 * j);
+      const double rsq = JKRDT::dot(d12, d12);
+      const double radsum = by == BY_SCENE ? scene_K->radsum : radius[i] + radius[j];
+      if (!bonded && rsq > radsum * radsum) continue;
+
+      // 2. orientation (p = particle 1) and constants
+      int p = i, q = j;
+      if (TANGENTIAL && tag[j] < tag[i]) {
+        std::swap(p, q);
+        d12 = -d12;
+      }
+      const JKRDT::ContactConstants &K = constants(p, q);
+
+      // a grain of a fragment that has left for good meets nothing, and its own contacts
+      // stand still: they are only evaluated, as a set-up does, for their potential energy
+      const int owned = (p < nlocal) + (q < nlocal);    // a contact counts half per owned atom
+      const bool parked = departed && ((mask[p] | mask[q]) & departed);
+      if (parked && !(bonded && eflag)) {
+        if (bonded) acc.contact_ends += owned;
+        continue;
+      }
+      const bool setup = run_setup || parked;
+
+      // 3. the motion over the step, and the guards that name a pair the step cannot resolve
+      const double r = std::sqrt(rsq);
+      const double delta = radsum - r;    // eq. (3)
+      if (!std::isfinite(delta) || r == 0.0) return trouble(Trouble::BLOW_UP, p, q, r, 0.0, K);
+      JKRDT::ContactMotion m;
+      m.d12 = d12;
+      m.r = r;
+      m.rinv = 1.0 / r;
+      m.v12 = JKRDT::vec(v + 3 * p) - JKRDT::vec(v + 3 * q);
+      if (TANGENTIAL) {
+        m.w1 = JKRDT::vec(omega + 3 * p);
+        m.w2 = JKRDT::vec(omega + 3 * q);
+      }
+      m.vn = JKRDT::dot(m.v12, d12) * m.rinv;    // at the half step, > 0 when separating
+      const double step = parked ? 0.0 : std::fabs(m.vn) * dt;
+      if (step > half_skin) return trouble(Trouble::FAST_PAIR, p, q, m.vn, 0.0, K);
+      if (!setup) acc.step_max = std::max(acc.step_max, step * K.inv_delta_c);
+      const bool formed = !bonded;    // delta >= 0 here: contact formation (section 2.1)
+      if (formed && setup && delta >= std::min(radius[p], radius[q]))
+        return trouble(Trouble::OVERLAP, p, q, delta, 0.0, K);
+      // a contact forms within the step that closes the gap: deeper means it was missed
+      if (formed && !setup && delta > 2.0 * step + LATE_SLACK * K.S.delta_c)
+        return trouble(Trouble::LATE, p, q, delta, step, K);
+
+      // 4. the contact over the step: the whole kernel, or its normal part alone
+      double *state = layout.dnum ? slot_values + (bigint) s * layout.dnum : nullptr;
+      V3 fp;
+      bool broken, lossy;
+      const double *loss;
+      double U_n;
+      JKRDT::NormalResult n;
+      double normal_loss[2];
+      if (TANGENTIAL) {
+        JKRDT::contact_step(K, layout, m, delta, dt, setup, formed, eflag, state, out);
+        fp = out.F1;
+        broken = out.broken;
+        lossy = out.lossy;
+        loss = out.loss;
+        U_n = out.U_n;
+      } else {
+        JKRDT::normal_step(K, layout, m.vn, delta, dt, setup, formed, eflag, state, n);
+        fp = (n.f * m.rinv) * d12;
+        broken = n.broken;
+        lossy = n.lossy;
+        normal_loss[JKRDT::LOSS_FORM_BREAK] = n.loss_event;
+        normal_loss[JKRDT::LOSS_DAMPING] = n.loss_damping;
+        loss = normal_loss;
+        U_n = n.U_n;
+      }
+      constexpr int nloss = TANGENTIAL ? JKRDT::NLOSS : JKRDT::LOSS_DAMPING + 1;
+      if (!broken && !std::isfinite(fp.x + fp.y + fp.z))
+        return trouble(Trouble::NOT_FINITE, p, q, 0, 0, K);
+      bonded_slot[s] = !broken;
+
+      // 5. force on p: normal (eq. 5 and A.5) plus sliding (eq. 14), -force on q; torques
+      // eqs. (17), (23), (27); half of the step's dissipation to each owned atom
+      if (!parked)
+        for (int side = 0; side < 2; side++) {
+          const int a = side ? q : p;
+          if (a >= nlocal) continue;
+          double *fa, *ta, *la;
+          if (!thread_of_atom || thread_of_atom[a] == me) {
+            fa = f[a];
+            ta = tq[a];
+            la = ledger[a];
+          } else {
+            acc.far.push_back(FarLoad{a, {0, 0, 0}, {0, 0, 0}, {0, 0, 0, 0, 0}});
+            fa = acc.far.back().f;
+            ta = acc.far.back().torque;
+            la = acc.far.back().loss;
+          }
+          if (lossy && !setup)
+            for (int l = 0; l < nloss; l++) la[l] += 0.5 * loss[l];
+          if (broken) continue;
+          const V3 fa_add = side ? -fp : fp;
+          fa[0] += fa_add.x;
+          fa[1] += fa_add.y;
+          fa[2] += fa_add.z;
+          if (TANGENTIAL) {
+            const V3 &ma = side ? out.M2 : out.M1;
+            ta[0] += ma.x;
+            ta[1] += ma.y;
+            ta[2] += ma.z;
+          }
+        }
+      if (broken) continue;
+
+      // energy and virial
+      acc.contact_ends += owned;
+      if (!eflag && !vflag_either) continue;
+      const double share = 0.5 * owned;
+      const double u = TANGENTIAL ? U_n + out.U[0] + out.U[1] + out.U[2] : U_n;
+      if (eflag) {
+        acc.upot += share * U_n;
+        if (TANGENTIAL)
+          for (int ch = 0; ch < JKRDT::NCHANNEL; ch++) acc.utan[ch] += share * out.U[ch];
+      }
+      if (tally_atoms) {
+        ev_tally_xyz(p, q, nlocal, 0, u, 0.0, fp.x, fp.y, fp.z, d12.x, d12.y, d12.z);
+        continue;
+      }
+      // ev_tally_xyz with newton off, by hand: thread-safe into this thread's sums
+      if (eflag_global) acc.eng += share * u;
+      if (vflag_global) {
+        acc.virial[0] += share * d12.x * fp.x;
+        acc.virial[1] += share * d12.y * fp.y;
+        acc.virial[2] += share * d12.z * fp.z;
+        acc.virial[3] += share * d12.x * fp.y;
+        acc.virial[4] += share * d12.x * fp.z;
+        acc.virial[5] += share * d12.y * fp.z;
+      }
+    }
+  }
+}
+
+/* ----------------------------------------------------------------------
+   this rank's share of the 10 values of compute pair jkr/dt; compute pair
+   sums them over ranks
+------------------------------------------------------------------------- */
+
+void PairJKRDT::fill_pvector(double upot, const double *utan, double contacts)
+{
+  std::fill(pvector, pvector + NPVECTOR, 0.0);
+  pvector[0] = upot;    // U_n
+  for (int ch = 0; ch < JKRDT::NCHANNEL; ch++) pvector[1 + ch] = utan[ch];    // U_s, U_r, U_t
+  const auto &C = *fix_contacts;
+  for (int i = 0; i < atom->nlocal; i++)
+    for (int l = 0; l < Contacts::NLEDGER; l++) pvector[4 + l] += C.ledger[i][l];
+  pvector[9] = contacts;
+  for (int l = 0; l < NPVECTOR; l++)
+    if (!std::isfinite(pvector[l]))
+      error->one(FLERR,
+                 "pair jkr/dt: value {} of the energy ledger is not finite at step {} (timestep "
+                 "= {:.3g} t_c): the run has blown up; reduce the timestep",
+                 l + 1, update->ntimestep, update->dt / tc_min);
+}
+
