@@ -34,17 +34,18 @@ ENERGY_THERMO = "step ke c_erot pe c_p[1] c_p[5] c_p[6] c_p[7] c_p[8] c_p[9] c_p
 
 def two_grain_scene(lmp, separation, v_rel=0.0, material=ICE, coeff_extra="frictionless",
                     dt_over_tc=0.01, newton="off", box=2.0e-6, radius=R_GRAIN, skin=None,
-                    settings=""):
+                    settings="", atom_style="sphere"):
     """Two grains of ``radius`` (default 0.1 micron ice) on the x axis, ``separation``
     apart (centre to centre), approaching each other at ``v_rel``. The neighbor skin
-    is ``skin`` (default 2 delta_c); ``settings`` go on the pair_style line. Thermo
-    carries the energy ledger."""
+    is ``skin`` (default 2 delta_c); ``settings`` go on the pair_style line
+    (``atom_style="sphere 1"``: radii that may change during a run). Thermo carries the
+    energy ledger."""
     r = radius
     s = scales(material, r)
     skin = 2 * s.delta_c if skin is None else skin
     lmp.commands_string(f"""
         units si
-        atom_style sphere
+        atom_style {atom_style}
         atom_modify map array
         boundary f f f
         newton {newton}

@@ -91,3 +91,24 @@ def test_unequal_radii_use_the_reduced_radius(lmp):
     lmp.command("run 0")
     s = type("Scales", (), dict(F_c=F_c, delta0=delta0, delta_c=delta_c))
     assert -atom_force_x(lmp, 1) == pytest.approx(jkr_force(-0.5 * delta_c, s), rel=1e-9)
+
+
+def test_radii_changed_during_a_run_by_fix_adapt_follow_eq5(lmp):
+    # fix adapt grows both grains by 1 % during a run with the positions frozen. The pair
+    # looks its contact constants up once per scene while the radii are those of the types,
+    # so it must see the new radii at every step while a fix adapt is defined: the force is
+    # eq. (5) for the new R and delta, not for the radii the run started with
+    from jkrdt.materials import ICE, scales
+    separation = 2 * R_GRAIN - S.delta0
+    two_grain_scene(lmp, separation, atom_style="sphere 1")
+    lmp.command("unfix integrate")
+    lmp.command("run 0")
+    assert abs(atom_force_x(lmp, 1)) < 1e-10 * S.F_c
+    grown = 1.01 * R_GRAIN
+    lmp.command(f"variable diameter equal {2 * grown!r}")
+    lmp.command("fix grow all adapt 1 atom diameter v_diameter")
+    lmp.command("run 2")
+    s = scales(ICE, grown)
+    want = jkr_force(2 * grown - separation, s)
+    assert want > S.F_c               # the old radii, at their equilibrium, give none
+    assert -atom_force_x(lmp, 1) == pytest.approx(want, rel=1e-9)
