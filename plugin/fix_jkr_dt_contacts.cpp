@@ -108,7 +108,6 @@ void FixJKRDTContacts::check_atoms(bigint natoms_before)
   for (size_t e = 0; e < flat.size(); e += 2) renamed.emplace_back(flat[e], flat[e + 1]);
   std::sort(renamed.begin(), renamed.end());
 
-
   bigint removed = 0, all_removed = 0;
   for (int i = 0; i < nlocal; i++) {
     for (int k = npartner[i] - 1; k >= 0; k--) {
