@@ -67,13 +67,23 @@ inline V3 unit(const V3 &a) { return (1.0 / norm(a)) * a; }
 // precision and needs no sqrt, sin or cos (its coefficients are multiplied, not
 // divided: a division costs more than the rest of the turn). One Newton step for
 // 1/|n| puts the result back on the unit sphere.
+// the series of a and b, below t^2 = 1e-4; T: a number, or one per lane
+template <class T> inline T turn_series_a(const T &t2)
+{
+  return 1.0 - t2 * (1.0 / 6.0) * (1.0 - t2 * (1.0 / 20.0) * (1.0 - t2 * (1.0 / 42.0)));
+}
+template <class T> inline T turn_series_b(const T &t2)
+{
+  return 0.5 - t2 * (1.0 / 24.0) * (1.0 - t2 * (1.0 / 30.0) * (1.0 - t2 * (1.0 / 56.0)));
+}
+
 inline V3 turned(const V3 &n, const V3 &w)
 {
   const double t2 = dot(w, w);
   double a, b;
   if (t2 < 1.0e-4) {
-    a = 1.0 - t2 * (1.0 / 6.0) * (1.0 - t2 * (1.0 / 20.0) * (1.0 - t2 * (1.0 / 42.0)));
-    b = 0.5 - t2 * (1.0 / 24.0) * (1.0 - t2 * (1.0 / 30.0) * (1.0 - t2 * (1.0 / 56.0)));
+    a = turn_series_a(t2);
+    b = turn_series_b(t2);
   } else {
     const double t = std::sqrt(t2);
     a = std::sin(t) / t;
@@ -103,11 +113,9 @@ inline void turned(V3 &n1, const V3 &w1, V3 &n2, const V3 &w2)
     n2 = turned(n2, w2);
     return;
   }
-  const Lanes one = {1.0, 1.0}, half = {0.5, 0.5};
-  const Lanes a = one - t2 * (1.0 / 6.0) * (one - t2 * (1.0 / 20.0) * (one - t2 * (1.0 / 42.0)));
-  const Lanes b = half - t2 * (1.0 / 24.0) * (one - t2 * (1.0 / 30.0) * (one - t2 * (1.0 / 56.0)));
+  const Lanes a = turn_series_a(t2), b = turn_series_b(t2);
   const V3x2 wn = {w.y * n.z - w.z * n.y, w.z * n.x - w.x * n.z, w.x * n.y - w.y * n.x};
-  const Lanes c = one - b * t2, e = b * dot(w, n);
+  const Lanes c = 1.0 - b * t2, e = b * dot(w, n);
   const V3x2 r = {c * n.x + a * wn.x + e * w.x, c * n.y + a * wn.y + e * w.y,
                   c * n.z + a * wn.z + e * w.z};
   const Lanes g = 1.5 - 0.5 * dot(r, r);

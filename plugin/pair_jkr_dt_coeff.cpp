@@ -85,11 +85,26 @@ constexpr Keyword KEYWORDS[PairJKRDT::NKEY] = {
 constexpr const char *FRICTIONLESS = "frictionless";     // sliding, rolling, twisting off
 constexpr const char *DATA_CONTACTS = "data_contacts";   // write_data's mark
 
+// the table is indexed by its keys (resolve() reads KEYWORDS[key])
+constexpr bool in_key_order()
+{
+  for (int k = 0; k < PairJKRDT::NKEY; k++)
+    if (KEYWORDS[k].key != k) return false;
+  return true;
+}
+static_assert(in_key_order(), "KEYWORDS must list the keys in the order of PairJKRDT::Key");
+
 const Keyword *keyword(const std::string &word)
 {
   for (const Keyword &k : KEYWORDS)
     if (word == k.name) return &k;
   return nullptr;
+}
+
+// any word of a pair_coeff line that is not a value
+bool is_keyword(const std::string &word)
+{
+  return keyword(word) || word == FRICTIONLESS || word == DATA_CONTACTS;
 }
 
 std::string keyword_list()
@@ -174,7 +189,7 @@ void PairJKRDT::coeff(int narg, char **arg)
   bigint marked = 0;
   int iarg = 2;
   auto value = [&](const std::string &key) -> const char * {
-    if (iarg + 1 >= narg || keyword(arg[iarg + 1]) || arg[iarg + 1] == std::string(FRICTIONLESS))
+    if (iarg + 1 >= narg || is_keyword(arg[iarg + 1]))
       error->all(FLERR, "pair_coeff for jkr/dt: keyword '{}' needs a value{}", key,
                  iarg + 1 < narg ? fmt::format(" (next is the keyword '{}')", arg[iarg + 1])
                                  : std::string(" (the line ends)"));
