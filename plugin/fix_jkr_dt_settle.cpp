@@ -26,7 +26,8 @@ using namespace LAMMPS_NS;
 /* ---------------------------------------------------------------------- */
 
 FixJKRDTSettle::FixJKRDTSettle(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), window(5), tolerance(0.01), counts(1.0e-4), cap(-1.0), state(RUNNING), last_check(-1),
+    Fix(lmp, narg, arg), window(5), tolerance(0.01), counts(1.0e-4), cap(-1.0), state(RUNNING),
+    rerun(false), last_check(-1),
     now{0, 0, 0, 0.0}, departure(lmp), table_append(false)
 {
   const char *usage = "fix ID all jkr/dt/settle N window K tolerance f [counts c] [cap T] "
@@ -73,7 +74,7 @@ FixJKRDTSettle::FixJKRDTSettle(LAMMPS *lmp, int narg, char **arg) :
   if (!table_path.empty()) table.reset(new SettleTable(lmp, table_path, table_append));
   restart_global = 1;
   vector_flag = 1;
-  size_vector = 7;
+  size_vector = 8;
   global_freq = 1;
   extvector = 0;
 }
@@ -124,6 +125,7 @@ void FixJKRDTSettle::setup(int)
   // every run is watched anew, its window continuing the checks of earlier runs (a
   // run in chunks), unless the step count went back (reset_timestep, a restart)
   state = RUNNING;
+  rerun = false;
   if (update->ntimestep < last_check) history.clear();
   if (history.empty()) {
     Graph graph;
@@ -240,7 +242,14 @@ void FixJKRDTSettle::end_of_step()
       next_reneighbor = update->ntimestep + 1;
   }
   write_check(graph);
-  if (reason != RUNNING) stop(reason);
+  if (reason != RUNNING) {
+    stop(reason);
+  } else if (PairJKRDT::active(lmp)->bins_outgrown()) {
+    rerun = true;
+    if (comm->me == 0)
+      utils::logmesg(lmp, "jkr/dt/settle: new run for wider bins step {}\n", update->ntimestep);
+    timer->force_timeout();
+  }
 }
 
 void FixJKRDTSettle::stop(int reason)
@@ -269,7 +278,8 @@ double FixJKRDTSettle::compute_vector(int n)
     case 3: return static_cast<double>(now.contacts);
     case 4: return static_cast<double>(last_check);
     case 5: return departure.departed_grains;
-    default: return departure.departed_fragments;
+    case 6: return departure.departed_fragments;
+    default: return rerun ? 1.0 : 0.0;
   }
 }
 

@@ -41,6 +41,13 @@
    (L the smallest atom ID) so that the rule can be checked against a run
    that keeps every fragment.
 
+   The fix also ends a run, still unsettled, at a check where pair jkr/dt
+   reports its neighbor bins outgrown by the spreading box (LAMMPS takes the
+   bin size at a run's start only; pair_jkr_dt_bins.cpp), writing
+     jkr/dt/settle: new run for wider bins step 123000
+   with vector value 8 set to 1 until the next run starts: the scene's deck
+   and jkrdt.Session then run on from that step with a new run.
+
    table FILE [append yes|no]: at every check (and at the first set-up) rank 0
    writes one row of the fragments to FILE, a CSV table
    (fix_jkr_dt_settle_table.cpp has the columns), so that the timeline of a
@@ -88,6 +95,7 @@ class FixJKRDTSettle : public Fix {
   double counts;                 // c: change of N_lar and of the fragment count, of all grains
   double cap;                    // simulated time at which the run stops unsettled; < 0 none
   int state;
+  bool rerun;                    // this run was ended for the pair's wider bins
   bigint last_check;
   Partition now;
   std::deque<Partition> history;    // the last K + 1 checks

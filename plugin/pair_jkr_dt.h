@@ -103,8 +103,15 @@ class PairJKRDT : public Pair {
   FixJKRDTContacts *contacts();
   // bins that grow with the box (pair_jkr_dt_bins.cpp); before each reneighboring
   static constexpr double BINS_PER_GRAIN = 32.0;
+  // the neighbor bins are outgrown when the side they need is this much wider than the
+  // side of this run's bins (a factor 1.95 in their number)
+  static constexpr double BINS_OUTGROWN = 1.25;
   // cutneigh: the neighbor cutoff (Neighbor's cutneighmax once it is set up)
   void fit_bins(double cutneigh);
+  // LAMMPS takes the neighbor bin size at a run's start only: true once the box has
+  // outgrown this run's bins, so that a new run (which fix jkr/dt/settle asks for at its
+  // next check) would bin the grains in BINS_PER_GRAIN per grain again
+  bool bins_outgrown() const { return bins_stale; }
 
  protected:
   std::vector<Input> input;    // (ntypes+1)^2, row-major
@@ -138,6 +145,8 @@ class PairJKRDT : public Pair {
   bool bins_bounded;           // pair_style ... bins bounded (default) or box
   double bin_size_set;         // the neighbor and sort bin size fit_bins() set last (0: LAMMPS's)
   double bin_size_logged;      // the bin size last written to the log
+  double bin_size_run;         // the side of this run's neighbor bins (set at its start)
+  bool bins_stale;             // the box has outgrown this run's neighbor bins
 
   int nstride;                 // ntypes + 1
   Input &in(int i, int j) { return input[i * nstride + j]; }

@@ -103,6 +103,8 @@ void PairJKRDT::init_style()
 
   neighbor->add_request(this, NeighConst::REQ_NEWTON_OFF);
   fit_bins(cutmax + neighbor->skin);
+  bin_size_run = neighbor->binsizeflag ? neighbor->binsize_user : 0.5 * (cutmax + neighbor->skin);
+  bins_stale = false;
 
   const int nthreads = nthreads_used();
   if (comm->me == 0 && nthreads != threads_logged)

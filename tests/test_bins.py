@@ -146,3 +146,80 @@ def test_bins_setting_names_its_values(lmp):
     far_pairs_scene(lmp, 1.0e-6)
     with pytest.raises(Exception, match="bins takes bounded or box"):
         lmp.command("pair_style jkr/dt bins wide")
+
+
+def flying_apart(lmp, v, every=None):
+    """Four single ice grains 1 micron apart flying apart along the diagonals of a cube at
+    ``v`` m/s, with ``every``, watched by fix jkr/dt/settle every that many steps (a window
+    too long to settle): a shrink-wrapped box that grows in all three directions."""
+    s = scales(ICE, R)
+    corners = [(1, 1, 1), (-1, -1, 1), (-1, 1, -1), (1, -1, -1)]
+    atoms = "\n".join(f"create_atoms 1 single {0.5e-6 * a!r} {0.5e-6 * b!r} {0.5e-6 * c!r}"
+                      for a, b, c in corners)
+    speeds = "\n".join(f"set atom {k + 1} vx {v * a / 3 ** 0.5!r} vy {v * b / 3 ** 0.5!r} "
+                       f"vz {v * c / 3 ** 0.5!r}" for k, (a, b, c) in enumerate(corners))
+    lmp.commands_string(SHRINK_WRAPPED + f"""
+        region box block -1e-6 1e-6 -1e-6 1e-6 -1e-6 1e-6
+        create_box 1 box
+        {atoms}
+        set type 1 diameter {2 * R!r}
+        set type 1 density {ICE.density!r}
+        velocity all set 0 0 0
+        {speeds}
+        pair_style jkr/dt
+        pair_coeff * * gamma {ICE.gamma!r} E {ICE.E!r} nu {ICE.nu!r} frictionless
+        neighbor {2 * s.delta_c!r} bin
+        neigh_modify every 1 delay 0 check yes
+        fix integrate all nve/sphere
+        timestep {0.3 * s.t_c!r}
+    """)
+    if every:
+        lmp.command(f"fix settle all jkr/dt/settle {every} window 1000 tolerance 0.01 depart no")
+    return s
+
+
+def memory_mb(lmp, tmp_path):
+    """LAMMPS's own count of its memory on this rank ('info memory'), MB."""
+    lmp.command(f"info memory out overwrite {tmp_path / 'info.txt'}")
+    text = (tmp_path / "info.txt").read_text()
+    return float(re.search(r"Total dynamically allocated memory: ([0-9.]+) Mbyte", text)[1])
+
+
+@pytest.mark.parametrize("parts", [True, False], ids=["in parts", "one run"])
+def test_bins_outgrown_during_a_run_are_taken_by_the_next(lmp, tmp_path, parts):
+    # LAMMPS takes its neighbor bin size when a run is set up. Grains flying apart at
+    # 400 m/s spread the box from 1 to ~30 micron in 3000 steps, (30 / 0.1)^3 ~ 2e7 bins of
+    # LAMMPS's size: 100 MB. The settle fix ends the run at a check once the pair's bins are
+    # outgrown; the next run (as the scene's deck and Session run them) takes the wider
+    # size, so the bins stay within ~2 x 32 per grain and the memory where it started.
+    # Without the settle fix nothing asks for a new run: one run keeps the first size
+    lmp.command(f"log {tmp_path / 'log.lammps'}")
+    s = flying_apart(lmp, 400.0, every=100 if parts else None)
+    lmp.command("run 0")
+    start = memory_mb(lmp, tmp_path)
+    x0 = lmp.numpy.extract_atom("x")[:4][np.argsort(lmp.numpy.extract_atom("id")[:4])]
+    end, runs = 3000, 0
+    while lmp.get_thermo("step") < end:
+        lmp.command(f"run {end} upto")
+        runs += 1
+        if not parts or lmp.extract_fix("settle", 0, 1, 7) != 1.0:
+            break
+    assert lmp.get_thermo("step") == end
+    lmp.command("log none")
+    log = (tmp_path / "log.lammps").read_text()
+    width = np.subtract(*lmp.extract_box()[1::-1])
+    assert width.min() > 25e-6
+    # free flight, untouched by the parts: x = x0 + v t to the round-off of the coordinates
+    ids = lmp.numpy.extract_atom("id")[:4]
+    x = lmp.numpy.extract_atom("x")[:4][np.argsort(ids)]
+    v = lmp.numpy.extract_atom("v")[:4][np.argsort(ids)]
+    np.testing.assert_allclose(x, x0 + v * end * 0.3 * s.t_c, atol=1e-15)
+    memory = memory_mb(lmp, tmp_path)
+    if parts:
+        assert runs == log.count("jkr/dt/settle: new run for wider bins") + 1 >= 3
+        print(f"in parts: {start:.2f} -> {memory:.2f} MB")
+        assert memory < 1.5 * start, f"{start:.2f} -> {memory:.2f} MB"
+    else:
+        assert runs == 1 and "new run for wider bins" not in log
+        print(f"one run: {start:.2f} -> {memory:.2f} MB")
+        assert memory > 10 * start, f"{start:.2f} -> {memory:.2f} MB: the bins did not grow"

@@ -73,6 +73,8 @@ NSQ_MAX = 2000
 FINISH_LINE = "jkr/dt: run finished step"
 #: the line fix jkr/dt/settle writes when it ends a run
 SETTLE_LINE = "jkr/dt/settle: stop_reason"
+# ... and the line it writes when it ends a part of the run for wider neighbor bins
+PART_LINE = "jkr/dt/settle: new run for wider bins step"
 
 
 # ---- clearing ----------------------------------------------------------------------
@@ -288,6 +290,12 @@ def run_status(run, last_dump_step: int | None = None) -> RunStatus:
     if header and (not loops or loops[-1] < header[-1]):
         return RunStatus("cut off", last_step, f"{log} ends inside a run at step {last_step}: "
                          "the run was cut off")
+    parts = [k for k, line in enumerate(lines) if line.startswith(PART_LINE)]
+    if parts and not any(k > parts[-1] for k in header):
+        return RunStatus("cut off", last_step, f"{log}: the settle rule ended a part of the "
+                         f"run at step {last_step} for wider neighbor bins, and the deck did "
+                         "not run the next part (a deck written before runs in parts): write "
+                         "the scene anew (jkrdt setup ... --force) and run it again")
     if not any(line.startswith(FINISH_LINE) for line in lines):
         return RunStatus("cut off", last_step, f"{log} stops at step {last_step} without its "
                          f"last line ('{FINISH_LINE} ...'): the run was cut off between two "

@@ -139,20 +139,24 @@ class Session:
 
         bar = tqdm(total=steps, unit="step", disable=not progress or self.comm.rank != 0)
         done = 0
+        pre = "no"
         while done < steps:
             n = min(chunk, steps - done)
             before = self.lmp.get_thermo("step")
             try:
-                self.lmp.command(f"run {n} pre no post no")
+                self.lmp.command(f"run {n} pre {pre} post no")
             except Exception:
                 self.stop_reason = "error"
                 raise
             ran = int(self.lmp.get_thermo("step") - before)
-            done += n
+            done += ran
             self._sample()
             bar.update(ran)
-            if self.settle is not None and self.settle_state() != "running":
+            if ran == 0 or (self.settle is not None and self.settle_state() != "running"):
                 break
+            # the settle rule ended the chunk for wider neighbor bins, which LAMMPS takes
+            # only when a run is set up (plugin/pair_jkr_dt_bins.cpp)
+            pre = "yes" if self.settle is not None and self.bins_outgrown() else "no"
         bar.close()
         return self.thermo()
 
@@ -162,6 +166,12 @@ class Session:
 
         state = self.lmp.extract_fix("settle", LMP_STYLE_GLOBAL, LMP_TYPE_VECTOR, 0)
         return ("running", "settled", "cap")[int(state)]
+
+    def bins_outgrown(self) -> bool:
+        """Whether fix jkr/dt/settle ended the last run for the pair's wider neighbor bins."""
+        from lammps import LMP_STYLE_GLOBAL, LMP_TYPE_VECTOR
+
+        return self.lmp.extract_fix("settle", LMP_STYLE_GLOBAL, LMP_TYPE_VECTOR, 7) == 1.0
 
     def run_until_settled(self, progress: bool = True) -> dict:
         """Run until the collision has settled or the cap is reached, checking the settle
