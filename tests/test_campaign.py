@@ -260,3 +260,27 @@ def test_failed_run_is_recorded_and_left_out_of_the_summary(tmp_path):
     assert retried["ran"] == 1 and len(retried["failed"]) == 1     # tried again, failed again
     with pytest.raises(ValueError, match=r"none of its 1 runs is complete \(\['error'\]\)"):
         summarise(tmp_path / "runs", plot=False)
+
+
+def test_a_campaign_with_dt_auto_runs_each_speed_at_the_dt_chosen_for_its_tolerance(tmp_path):
+    # "dt": "auto" is jkrdt setup's --dt auto per speed: the largest dt that the bounds of
+    # jkrdt.timestep allow for max |dE| / E_imp <= tolerance, so each run's energy error
+    # stays within it (the bounds lie on or above the worst run of their ensembles)
+    from jkrdt import rundir, timestep
+    from jkrdt.materials import material, scales
+
+    spec = tmp_path / "spec.json"
+    spec.write_text(json.dumps(dict(SPEC, model="frictionless", v_col=[5.0, 40.0],
+                                    b_off2=[0.0], dt="auto", tolerance=1e-3)))
+    assert run_campaign(spec, tmp_path / "runs", progress=False)["ran"] == 2
+    v0 = scales(material("ice"), 1e-7).v0
+    for v in (5.0, 40.0):
+        run = run_directory(tmp_path / "runs", v, 0.0, 2)
+        want, _ = timestep.choose(1e-3, v, v0, "frictionless", n_total=32)
+        meta = json.loads((run / rundir.META).read_text())
+        assert meta["dt_over_tc"] == want and "chosen for max |dE|/E_imp <= 0.001" in \
+            meta["dt_reason"]
+        out = json.loads((run / rundir.OUTCOME).read_text())
+        assert out["stop_reason"] == "settled" and out["energy_error"] <= 1e-3, out
+    record = json.loads((tmp_path / "runs" / "campaign.json").read_text())
+    assert record["spec"]["dt"] == "auto" and record["spec"]["tolerance"] == 1e-3

@@ -76,7 +76,9 @@ SPEC = dict(n_tar=8, n_pro=8, v_col=[10], b_off2=[0.0])
     (dict(seeds="1"), '"seeds" must be a non-empty list of whole numbers'),
     (dict(material="granite"), "unknown material 'granite'"),
     (dict(material_overrides={"hardness": 3}), '"material"/"material_overrides"'),
-    (dict(dt=5), '"dt" must be a time step in (0, 0.4] in units of t_c'),
+    (dict(dt=5), '"dt" must be a time step in (0, 0.4] in units of t_c, or "auto"'),
+    (dict(dt="auto", tolerance=2), '"tolerance" must be a relative energy error in (0, 1)'),
+    (dict(tolerance=1e-3), '"tolerance" goes with "dt": "auto"'),
 ])
 def test_campaign_spec_errors_name_the_key(tmp_path, change, match):
     spec = tmp_path / "spec.json"

@@ -28,7 +28,6 @@ validation/runs/bpca3d_models, not committed); a second call resumes them.
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import sys
@@ -37,12 +36,11 @@ from pathlib import Path
 
 import numpy as np
 
-from common import run_campaigns, save
+from common import campaign_study_parser, run_campaigns, save, study_paths
 from jkrdt.analysis.summary import b_off_average, cumulative_on, summarise, threshold_velocity
 from jkrdt.analysis.tables import write_csv
 from jkrdt import rundir
 
-HERE = Path(__file__).resolve().parent
 #: the paper's four models: (model, T_vis) and its v_fra at 10^5 grains, m/s
 MODELS = {"frictional": ("frictional", 0.0, 60.0),
           "frictional, T_vis 6 ps": ("frictional", 6e-12, 50.0),
@@ -174,28 +172,19 @@ def figures(curves: dict, results: Path) -> list[Path]:
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--quick", action="store_true", help="the small variant of the tests")
+    p = campaign_study_parser(__doc__)
     p.add_argument("--sizes", type=int, nargs="+", default=None,
                    help="grains per aggregate, one campaign set each (default: 100 250)")
     p.add_argument("--large-seeds", type=int, nargs="+", default=[1],
                    help=f"the seeds of sizes from {LARGE} on, run at v_col = "
                    f"{', '.join(f'{v:g}' for v in LARGE_V_COL)} m/s (default: %(default)s)")
-    p.add_argument("--np", type=int, default=min(2, os.cpu_count() or 1),
-                   help="MPI ranks, one collision each (default %(default)s)")
-    p.add_argument("--runs", type=Path, default=None)
-    p.add_argument("--results", type=Path, default=None)
     args = p.parse_args(argv)
     plan = dict(QUICK if args.quick else FULL)
     if args.sizes:
         plan["sizes"] = args.sizes
     if not args.quick:
         plan["large_seeds"] = args.large_seeds
-    tag = "bpca3d_models" + ("_quick" if args.quick else "")
-    runs = args.runs or HERE / "runs" / tag
-    results = args.results or HERE / tag
-    results.mkdir(parents=True, exist_ok=True)
+    runs, results = study_paths(args, "bpca3d_models")
     t0 = time.time()
     curves = {}
     for n in plan["sizes"]:

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import argparse
 import json
+import os
 import re
 import subprocess
 import sys
@@ -10,6 +12,30 @@ import time
 from pathlib import Path
 
 BIN = Path(sys.executable).parent
+HERE = Path(__file__).resolve().parent
+
+
+def campaign_study_parser(doc: str) -> argparse.ArgumentParser:
+    """The options every campaign study takes: --quick, --np, --runs, --results."""
+    p = argparse.ArgumentParser(description=doc,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--quick", action="store_true", help="the small variant of the tests")
+    p.add_argument("--np", type=int, default=min(2, os.cpu_count() or 1),
+                   help="MPI ranks, one collision each (default %(default)s)")
+    p.add_argument("--runs", type=Path, default=None,
+                   help="where the runs go (default validation/runs/STUDY[_quick])")
+    p.add_argument("--results", type=Path, default=None,
+                   help="where the tables and figures go (default validation/STUDY[_quick])")
+    return p
+
+
+def study_paths(args, study: str) -> tuple[Path, Path]:
+    """(runs, results) of ``study`` for the parsed options; the results folder made."""
+    tag = study + ("_quick" if args.quick else "")
+    runs = args.runs or HERE / "runs" / tag
+    results = args.results or HERE / tag
+    results.mkdir(parents=True, exist_ok=True)
+    return runs, results
 
 
 def loop_seconds(run: Path) -> float:

@@ -30,7 +30,6 @@ validation/runs/wada2007_2d, not committed); a second call resumes them.
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import os
@@ -40,11 +39,10 @@ from pathlib import Path
 
 import numpy as np
 
-from common import run_campaigns, save as save_figure
+from common import campaign_study_parser, run_campaigns, save as save_figure, study_paths
 from jkrdt.analysis.tables import write_csv
 from jkrdt import rundir
 
-HERE = Path(__file__).resolve().parent
 #: Table 3 of the paper: (material preset, xi_crit)
 SETS = {"quartz 2A": ("quartz", 2e-10), "quartz 30A": ("quartz", 30e-10),
         "ice 2A": ("ice", 2e-10), "ice 30A": ("ice", 30e-10)}
@@ -291,21 +289,9 @@ def figures(plan: dict, rows: list[dict], results: Path) -> list[Path]:
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--quick", action="store_true", help="the small variant of the tests")
-    p.add_argument("--np", type=int, default=min(2, os.cpu_count() or 1),
-                   help="MPI ranks, one collision each (default %(default)s)")
-    p.add_argument("--runs", type=Path, default=None,
-                   help="where the runs go (default validation/runs/wada2007_2d[_quick])")
-    p.add_argument("--results", type=Path, default=None,
-                   help="where the tables and figures go (default validation/wada2007_2d)")
-    args = p.parse_args(argv)
+    args = campaign_study_parser(__doc__).parse_args(argv)
     plan = QUICK if args.quick else FULL
-    tag = "wada2007_2d" + ("_quick" if args.quick else "")
-    runs = args.runs or HERE / "runs" / tag
-    results = args.results or HERE / tag
-    results.mkdir(parents=True, exist_ok=True)
+    runs, results = study_paths(args, "wada2007_2d")
     t0 = time.time()
     run_campaigns({name: spec(name, plan) for name in plan["sets"]}, runs, args.np)
     rows = collect(plan, runs)

@@ -11,7 +11,9 @@ A spec (JSON) names the grid and the scene:
 
 n_tar, n_pro, v_col and b_off2 are required; the other keys default to the values above
 (material_overrides {}, settle {} = the settle rule's defaults), and any Material field
-can be overridden in material_overrides.
+can be overridden in material_overrides. "dt" is in units of t_c, or "auto": each speed's
+dt then comes from "tolerance" (max |dE| / E_imp, default 1e-4) as ``jkrdt setup --dt auto
+--tolerance`` chooses it (``jkrdt.timestep``).
 
 Each run ends when its collision has settled (``jkrdt.stopping``; "settle" may be
 left out for the defaults, or given in part), or, with ``"settle": false``, after
@@ -59,9 +61,11 @@ from .aggregates import BUILDERS
 from .materials import material
 from .scene import Scene
 from .stopping import SettleRule
-from .timestep import DT_STABLE
+from .timestep import AUTO_TOLERANCE, DT_STABLE
+
 DEFAULTS = dict(kind="bpca", dim=3, material="ice", material_overrides={}, radius=1.0e-7,
-                model="frictional", seeds=[1], dt=0.014, settle={}, steps=None, every=None)
+                model="frictional", seeds=[1], dt=0.014, tolerance=None, settle={},
+                steps=None, every=None)
 REQUIRED = ["n_tar", "n_pro", "v_col", "b_off2"]
 
 
@@ -88,8 +92,10 @@ CHECKS = {
     "radius": (lambda x: _number(x) and x > 0, "a grain radius > 0 in m"),
     "model": (lambda x: x in ("frictional", "frictionless"), "'frictional' or 'frictionless'"),
     "material_overrides": (lambda x: isinstance(x, dict), "an object of Material fields"),
-    "dt": (lambda x: _number(x) and 0 < x <= DT_STABLE,
-           f"a time step in (0, {DT_STABLE}] in units of t_c"),
+    "dt": (lambda x: x == "auto" or (_number(x) and 0 < x <= DT_STABLE),
+           f"a time step in (0, {DT_STABLE}] in units of t_c, or \"auto\""),
+    "tolerance": (lambda x: x is None or (_number(x) and 0 < x < 1),
+                  "a relative energy error in (0, 1) that dt \"auto\" is chosen for"),
     "steps": (lambda x: x is None or (_whole(x) and x >= 1), "a whole number of steps >= 1"),
     "every": (lambda x: x is None or (_whole(x) and x >= 1), "a whole number of steps >= 1"),
     "settle": (lambda x: isinstance(x, (bool, dict)), "true, false or an object of SettleRule "
@@ -127,6 +133,11 @@ def read_spec(path) -> dict:
     if missing:
         raise ValueError(f"{path}: the campaign spec lacks {missing}")
     check_types(path, spec)
+    if spec["dt"] == "auto" and spec["tolerance"] is None:
+        spec["tolerance"] = AUTO_TOLERANCE
+    if spec["dt"] != "auto" and spec["tolerance"] is not None:
+        raise ValueError(f"{path}: \"tolerance\" goes with \"dt\": \"auto\" (the energy "
+                         "error dt is chosen for); give \"dt\": \"auto\", or leave it out")
     if any(not 0 <= b <= 1 for b in spec["b_off2"]):
         raise ValueError(f"{path}: b_off2 values are B_off^2 and must lie in [0, 1]")
     if spec["settle"] is False:
@@ -241,11 +252,13 @@ def plan(spec: dict, campaign) -> list[tuple[float, float, int, Path]]:
 
 def scene_of(spec: dict, v: float, b2: float, seed: int) -> Scene:
     """The scene of one run of the grid."""
-    return Scene(material=material(spec["material"], **spec["material_overrides"]),
-                 n_tar=spec["n_tar"], n_pro=spec["n_pro"], v_col=v, b_off=float(np.sqrt(b2)),
-                 seed=seed, kind=spec["kind"], dim=spec["dim"], radius=spec["radius"],
-                 model=spec["model"], dt_over_tc=spec["dt"],
-                 dt_reason=f"dt = {spec['dt']:g} t_c, the campaign's")
+    auto = spec["dt"] == "auto"
+    scene = Scene(material=material(spec["material"], **spec["material_overrides"]),
+                  n_tar=spec["n_tar"], n_pro=spec["n_pro"], v_col=v, b_off=float(np.sqrt(b2)),
+                  seed=seed, kind=spec["kind"], dim=spec["dim"], radius=spec["radius"],
+                  model=spec["model"], dt_over_tc=None if auto else spec["dt"],
+                  dt_reason=None if auto else f"dt = {spec['dt']:g} t_c, the campaign's")
+    return scene.with_dt_for(spec["tolerance"]) if auto else scene
 
 
 def prepare(directory: Path, scene: Scene, aggregates: dict):

@@ -87,9 +87,6 @@ def output_interval(steps: int) -> int:
     return next(d for d in range(max(1, steps // 20), 0, -1) if steps % d == 0)
 
 
-#: what --dt auto aims at without --tolerance
-AUTO_TOLERANCE = 1e-4
-
 MATERIAL_FIELDS = ("gamma", "E", "nu", "G", "density", "xi_crit", "tvis")
 
 
@@ -137,12 +134,6 @@ def build(args) -> int:
     return 0
 
 
-def bound_of(scene: Scene) -> dict:
-    """What the energy-error bound of ``jkrdt.timestep`` depends on besides dt and v_col."""
-    return dict(model=scene.model, n_total=scene.n_tar + scene.n_pro,
-                damped=scene.material.tvis > 0)
-
-
 def write_scene(scene: Scene, out, tolerance: float | None = None, force: bool = False):
     """Build the scene's aggregates, set up their collision and write it into ``out``,
     which must be empty unless ``force`` (then the files of an earlier scene and its run
@@ -156,13 +147,10 @@ def write_scene(scene: Scene, out, tolerance: float | None = None, force: bool =
         rundir.clear(out)
     if tolerance is not None:
         try:
-            dt, reason = timestep.choose(tolerance, scene.v_col, scene.scales.v0,
-                                         **bound_of(scene))
+            scene = scene.with_dt_for(tolerance)
         except ValueError as err:
             raise SystemExit(f"jkrdt: {err}") from None
-        scene = dataclasses.replace(scene, dt_over_tc=dt, dt_reason=reason)
-        expected = timestep.predicted_error(dt, scene.v_col / scene.scales.v0,
-                                            **bound_of(scene))
+        dt, expected = scene.dt_over_tc, scene.predicted_error()
         if expected > 1.001 * tolerance:
             print(f"jkrdt: WARNING: --dt auto cannot reach --tolerance {tolerance:g} at "
                   f"{scene.v_col:g} m/s: dt is held at {dt:g} t_c, where the fit expects max "
@@ -242,9 +230,9 @@ def setup(args) -> int:
     if args.tolerance is not None and args.dt != "auto":
         raise SystemExit("jkrdt: --tolerance goes with --dt auto (the energy error dt is "
                          "chosen for); give --dt auto, or leave --tolerance out")
+    tolerance = args.tolerance if args.tolerance is not None else timestep.AUTO_TOLERANCE
     write_scene(chosen_scene(args), args.out,
-                tolerance=(args.tolerance if args.tolerance is not None else AUTO_TOLERANCE)
-                if args.dt == "auto" else None, force=args.force)
+                tolerance=tolerance if args.dt == "auto" else None, force=args.force)
     return 0
 
 
@@ -457,7 +445,8 @@ def main(argv=None) -> int:
     st.add_argument("--force", action="store_true",
                     help="write into a non-empty --out, replacing an earlier scene and its run")
     st.add_argument("--tolerance", type=float, default=None,
-                    help=f"max |dE| / E_imp that --dt auto aims at (default {AUTO_TOLERANCE:g})")
+                    help="max |dE| / E_imp that --dt auto aims at (default "
+                         f"{timestep.AUTO_TOLERANCE:g})")
     st.add_argument("--skin", type=float, default=None,
                     help="neighbor skin, m (default: 1e-8, or 8 v_col dt where grains move "
                          "farther in a step: large grains, fast collisions)")

@@ -116,6 +116,24 @@ class Scene:
             return self.dt_over_tc, self.dt_reason or "the scene's dt"
         return PAPER_DT, f"dt = {PAPER_DT} t_c, the papers' choice (Wada et al. 2007, sec. 4)"
 
+    def energy_bound(self) -> dict:
+        """What the energy-error bound of ``jkrdt.timestep`` depends on besides dt and
+        v_col."""
+        return dict(model=self.model, n_total=self.n_tar + self.n_pro,
+                    damped=self.material.tvis > 0)
+
+    def predicted_error(self) -> float:
+        """The bound on max |dE| / E_imp at this scene's dt (``jkrdt.timestep``)."""
+        return timestep.predicted_error(self.time_step()[0], self.v_col / self.scales.v0,
+                                        **self.energy_bound())
+
+    def with_dt_for(self, tolerance: float) -> "Scene":
+        """This scene with dt chosen for a max |dE| / E_imp of ``tolerance``
+        (``jkrdt.timestep.choose``, which raises ValueError for a tolerance outside (0, 1))."""
+        dt, reason = timestep.choose(tolerance, self.v_col, self.scales.v0,
+                                     **self.energy_bound())
+        return dataclasses.replace(self, dt_over_tc=dt, dt_reason=reason)
+
     def skin_for(self, dt_over_tc: float) -> float:
         """The neighbor skin (m): the scene's own, else SKIN_MIN or, for grains that move
         farther in a step (large grains, fast collisions), SKIN_STEPS steps at 2 v_col."""

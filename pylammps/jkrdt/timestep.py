@@ -29,6 +29,8 @@ from pathlib import Path
 #: the papers' time step (Wada et al. 2007, sec. 4): |dE| / E_imp below 1e-4
 PAPER_DT = 0.014
 DT_MIN, DT_MAX = 0.002, 0.1      # t_c; above DT_MAX the plugin warns
+#: what dt "auto" aims at without a tolerance (jkrdt setup --dt auto, a campaign's spec)
+AUTO_TOLERANCE = 1e-4
 #: the plugin refuses dt above this (pair_style jkr/dt dt_check; benchmarks/stability.py)
 DT_STABLE = 0.4
 FIT_FILE = Path(__file__).with_name("timestep_fit.json")
