@@ -20,7 +20,7 @@ Writes RESULTS (default validation/vfra_size/): runs.csv (every run, with its lo
 and summary.json (per size and model: <f_gro> against v_col, v_fra with its bracket, the
 compute spent).
 
-    ./run validate vfra_size                    # 2 x 5000, 2 ranks: about a day of both cores
+    ./run validate vfra_size                    # 2 x 5000, 2 ranks: 100 runs, hours of both cores
     ./run validate vfra_size --sizes 10000
     ./run validate vfra_size --quick            # 2 x 24 grains, two models (tests)
 """
