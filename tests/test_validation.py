@@ -184,3 +184,27 @@ def test_the_size_study_places_v_fra_and_runs_seed_2_where_it_lies(tmp_path):
         assert c["seeds_v_fra"] and all(grid[0] < v < grid[-1] for v in c["seeds_v_fra"])
     # the 3D paper's order: without friction the aggregates break at lower speed
     assert at["frictionless"]["v_fra"] < at["frictional"]["v_fra"]
+
+
+def test_the_size_trend_places_v_fra_as_the_smaller_study_did():
+    # validation/vfra_size.py takes the committed runs of bpca3d_models (2 x 100, 250,
+    # 1000) into its trend of v_fra against N: from those rows it must find the v_fra that
+    # the smaller study's summary gives (its seeds averaged per B_off^2, then eq. 1)
+    sys.path.insert(0, str(ROOT / "validation"))
+    try:
+        from vfra_size import SMALLER, size_trend
+    finally:
+        sys.path.pop(0)
+    trend = size_trend(read_csv(SMALLER))
+    committed = json.loads((SMALLER.parent / "summary.json").read_text())["curves"]
+    for model, t in trend.items():
+        for p in t["points"]:
+            want = committed[str(int(p["n_total"]) // 2)][model]["v_fra"]
+            assert (p["v_fra"] is None) == (want is None), (model, p)
+            if want is not None:
+                assert p["v_fra"] == pytest.approx(want, rel=1e-12)
+                assert p["low"] <= p["v_fra"] <= p["high"]
+    # three sizes place the two undamped models: v_fra grows with N (41 -> 54 and
+    # 15 -> 22 m/s), and the fit's slope is positive
+    for model in ("frictional", "frictionless"):
+        assert trend[model]["fit"]["b"] > 0

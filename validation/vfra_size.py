@@ -36,10 +36,11 @@ from pathlib import Path
 import numpy as np
 
 from bpca3d_models import MODELS
-from common import campaign_study_parser, loop_seconds, run_campaigns, study_paths
+from common import HERE, campaign_study_parser, loop_seconds, run_campaigns, save, study_paths
 from jkrdt import rundir
-from jkrdt.analysis.summary import b_off_average, summarise, threshold_velocity
-from jkrdt.analysis.tables import write_csv
+from jkrdt.analysis.summary import b_off_average, threshold_velocity
+from jkrdt.analysis.tables import read_csv, write_csv
+from jkrdt.stopping import COMPLETE
 
 #: max |dE| / E_imp that each run's dt is chosen for
 TOLERANCE = 1e-3
@@ -55,6 +56,8 @@ QUICK = dict(sizes=[24], grids={"frictional": [10.0, 39.8, 100.0],
                                 "frictionless": [10.0, 39.8, 100.0]}, b_off2=[0.0, 0.5])
 FULL = dict(sizes=[5000], grids=GRIDS, b_off2=B_OFF2)
 SEEDS = (1, 2)              # phase 1, phase 2
+#: the committed runs of the smaller sizes (validation/bpca3d_models.py)
+SMALLER = HERE / "bpca3d_models" / "runs.csv"
 
 
 def spec(model: str, n: int, speeds: list[float], b_off2: list[float], seed: int) -> dict:
@@ -74,38 +77,26 @@ def nearest_two(c: dict) -> list[float]:
     return v[:2] if f[0] <= 0 else v[-2:]
 
 
-def curve(where: Path) -> dict:
-    """<f_gro>(v_col) and v_fra of the runs below ``where`` (``jkrdt summarise``: the seeds
-    averaged per B_off^2, then the B_off-weighted average), with v_fra's bracket."""
-    summary = summarise(where, plot=False)
-    table = sorted(summary["table"], key=lambda r: r["v_col"])
-    v = [r["v_col"] for r in table]
-    f = [r["mean_f_gro"] for r in table]
-    v_fra = threshold_velocity(v, f)
+def curve(rows: list[dict]) -> dict:
+    """<f_gro>(v_col) and v_fra of the finished runs in ``rows`` (as ``jkrdt summarise``
+    takes them: the seeds averaged per B_off^2, then the B_off-weighted average of eq. 1 of
+    the 3D paper), with the two grid speeds that bracket v_fra."""
+    done = [r for r in rows if r["stop_reason"] in COMPLETE]
+    v = sorted({r["v_col"] for r in done})
+    f = [b_weighted([(round(r["B_off"] ** 2, 12), r["growth_efficiency"])
+                     for r in done if r["v_col"] == x]) for x in v]
     bracket = next(([v[k], v[k + 1]] for k in range(len(v) - 1) if f[k] > 0 >= f[k + 1]),
                    None)
-    return dict(v_col=v, mean_f_gro=f, runs=[r["runs"] for r in table], v_fra=v_fra,
-                bracket=bracket)
+    return dict(v_col=v, mean_f_gro=f, runs=[sum(r["v_col"] == x for r in done) for x in v],
+                v_fra=threshold_velocity(v, f) if len(v) > 1 else None, bracket=bracket)
 
 
 def seed_spread(rows: list[dict]) -> list[float]:
     """v_fra of each seed's own curve, at the speeds that seed ran (the spread of v_fra
     from the seeds)."""
-    out = []
-    for seed in sorted({r["seed"] for r in rows}):
-        mine = [r for r in rows if r["seed"] == seed]
-        ran = sorted({r["v_col"] for r in mine})
-        if len(ran) < 2:
-            continue
-        f = []
-        for v in ran:
-            at = [r for r in mine if r["v_col"] == v]
-            f.append(b_weighted([(round(r["B_off"] ** 2, 12), r["growth_efficiency"])
-                                 for r in at]))
-        found = threshold_velocity(ran, f)
-        if found is not None:
-            out.append(found)
-    return out
+    found = [curve([r for r in rows if r["seed"] == seed])["v_fra"]
+             for seed in sorted({r["seed"] for r in rows})]
+    return [v for v in found if v is not None]
 
 
 def b_weighted(points: list[tuple[float, float]]) -> float:
@@ -116,13 +107,86 @@ def b_weighted(points: list[tuple[float, float]]) -> float:
                                              for c in b2])))
 
 
+def outcome_rows(home: Path, n: int, model: str) -> list[dict]:
+    """One row per finished run below ``home``, with its loop time."""
+    return [dict(size=n, model=model, loop_seconds=loop_seconds(Path(o["run"])),
+                 **{k: o.get(k) for k in (
+                     "v_col", "B_off", "seed", "n_total", "n_largest", "n_fragments",
+                     "growth_efficiency", "stop_reason", "stop_step", "time_end_over_tc",
+                     "energy_error", "kinetic_left")})
+            for o in (json.loads(p.read_text()) for p in sorted(home.rglob(rundir.OUTCOME)))]
+
+
+def size_trend(rows: list[dict]) -> dict:
+    """Per model: v_fra at each size with the range of its seeds' own v_fra, and the fit
+    v_fra = a + b log10(N_total) over the sizes that place it, with its value at the
+    paper's N_total = 10^5 (None where fewer than two sizes place v_fra)."""
+    out = {}
+    for model in MODELS:
+        mine = [r for r in rows if r["model"] == model]
+        points = []
+        for size in sorted({r["size"] for r in mine}):
+            at = [r for r in mine if r["size"] == size]
+            c = curve(at)
+            seeds = seed_spread(at)
+            points.append(dict(n_total=2 * size, v_fra=c["v_fra"], bracket=c["bracket"],
+                               low=min(seeds + [c["v_fra"]]) if c["v_fra"] else None,
+                               high=max(seeds + [c["v_fra"]]) if c["v_fra"] else None,
+                               fastest=c["v_col"][-1]))
+        placed = [p for p in points if p["v_fra"] is not None]
+        fit = None
+        if len(placed) >= 2:
+            b, a = np.polyfit(np.log10([p["n_total"] for p in placed]),
+                              [p["v_fra"] for p in placed], 1)
+            fit = dict(a=float(a), b=float(b), at_1e5=float(a + 5 * b))
+        out[model] = dict(points=points, fit=fit, paper_v_fra=MODELS[model][2])
+    return out
+
+
+def figure(trend: dict, results: Path) -> list[Path]:
+    """fig_vfra_size: v_fra against N_total per model, the seeds' range as error bars,
+    sizes whose grid reaches no v_fra as open triangles at its fastest speed, the fits to
+    10^5 and the paper's values."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    colours = dict(zip(MODELS, ("C0", "C1", "C3", "C2")))
+    fig, ax = plt.subplots(figsize=(8, 5), constrained_layout=True)
+    for k, (model, t) in enumerate(trend.items()):
+        c = colours[model]
+        placed = [p for p in t["points"] if p["v_fra"] is not None]
+        if placed:
+            n = np.array([p["n_total"] for p in placed], dtype=float)
+            v = np.array([p["v_fra"] for p in placed])
+            err = [v - [p["low"] for p in placed], [p["high"] for p in placed] - v]
+            ax.errorbar(n, v, yerr=err, fmt="o", color=c, capsize=3, label=model)
+        above = [p for p in t["points"] if p["v_fra"] is None]
+        if above:
+            ax.plot([p["n_total"] * 1.05 ** k for p in above],      # side by side
+                    [p["fastest"] for p in above], "^",
+                    color=c, mfc="none", ms=9, label=f"{model}: above the fastest speed run")
+        if t["fit"]:
+            x = np.logspace(np.log10(min(p["n_total"] for p in placed)), 5, 50)
+            ax.plot(x, t["fit"]["a"] + t["fit"]["b"] * np.log10(x), "--", color=c, lw=1)
+        ax.plot([1e5], [t["paper_v_fra"]], "*", ms=12, color=c, mec="k", mew=0.5)
+    ax.set_xscale("log")
+    ax.set_xlabel("N_total (grains in both aggregates)")
+    ax.set_ylabel("v_fra (m/s)")
+    ax.set_title("v_fra against size: points this study (error bars: the seeds), dashed "
+                 "fits a + b log N,\nstars the paper at 10^5, open triangles: no v_fra up to the "
+                 "fastest speed run", fontsize=8)
+    ax.legend(fontsize=8)
+    return save(fig, results, "fig_vfra_size")
+
+
 def run_model(model: str, n: int, plan: dict, runs: Path, ranks: int) -> Path:
     """Both phases of one model at 2 x ``n`` grains; returns the model's directory."""
     grid = plan["grids"][model]
     home = runs / f"n{n}" / model.replace(", ", "_").replace(" ", "_")
     run_campaigns({f"seed{SEEDS[0]}": spec(model, n, grid, plan["b_off2"], SEEDS[0])},
                   home, ranks)
-    second = nearest_two(curve(home / f"seed{SEEDS[0]}"))
+    second = nearest_two(curve(outcome_rows(home / f"seed{SEEDS[0]}", n, model)))
     run_campaigns({f"seed{SEEDS[1]}": spec(model, n, second, plan["b_off2"], SEEDS[1])},
                   home, ranks)
     return home
@@ -143,17 +207,11 @@ def main(argv=None) -> int:
         sizes[str(n)] = {}
         for model in plan["grids"]:
             home = run_model(model, n, plan, runs, args.np)
-            outcomes = [json.loads(o.read_text()) for o in sorted(home.rglob(rundir.OUTCOME))]
-            mine = [dict(size=n, model=model, loop_seconds=loop_seconds(Path(o["run"])),
-                         **{k: o.get(k) for k in (
-                             "v_col", "B_off", "seed", "n_total", "n_largest", "n_fragments",
-                             "growth_efficiency", "stop_reason", "stop_step",
-                             "time_end_over_tc", "energy_error", "kinetic_left")})
-                    for o in outcomes]
+            mine = outcome_rows(home, n, model)
             rows += mine
-            c = curve(home)
+            c = curve(mine)
             c.update(seeds_v_fra=seed_spread(mine),
-                     seed_2_at=nearest_two(curve(home / f"seed{SEEDS[0]}")),
+                     seed_2_at=nearest_two(curve([r for r in mine if r["seed"] == SEEDS[0]])),
                      paper_v_fra=MODELS[model][2],
                      stop_reasons={k: sum(r["stop_reason"] == k for r in mine)
                                    for k in sorted({r["stop_reason"] for r in mine})},
@@ -161,8 +219,15 @@ def main(argv=None) -> int:
                      core_hours=sum(r["loop_seconds"] for r in mine) / 3600)
             sizes[str(n)][model] = c
             write_csv(results / "runs.csv", rows)          # as each model finishes
+    # the size trend: the committed smaller sizes of bpca3d_models with these (not in the
+    # quick variant, whose sizes are its own)
+    before = [] if args.quick else [r for r in read_csv(SMALLER) if r["size"] not in
+                                    plan["sizes"]]
+    trend = size_trend(before + rows)
+    figure(trend, results)
     summary = dict(plan=plan, tolerance=TOLERANCE, ranks=args.np,
-                   seconds_this_call=time.time() - t0, load=os.getloadavg()[0], sizes=sizes)
+                   seconds_this_call=time.time() - t0, load=os.getloadavg()[0], sizes=sizes,
+                   trend=trend)
     (results / "summary.json").write_text(json.dumps(summary, indent=2, default=float) + "\n")
     print(json.dumps(sizes, indent=1, default=float))
     return 0
