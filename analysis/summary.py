@@ -49,6 +49,16 @@ def b_off_average(b_off2, values) -> np.ndarray:
     return (0.5 * widths * (a[1:] + a[:-1])).sum(axis=0)
 
 
+def b_off_mean(runs, value) -> np.ndarray:
+    """<A> of eq. (1) over ``runs`` (outcomes at one v_col): A = value(run) averaged over
+    the runs (seeds) of each B_off^2 first, then over B_off^2 by ``b_off_average``."""
+    by_b2 = defaultdict(list)
+    for o in runs:
+        by_b2[round(o["B_off"] ** 2, 12)].append(value(o))
+    b2 = np.array(sorted(by_b2))
+    return b_off_average(b2, np.array([np.mean(by_b2[b], axis=0) for b in b2]))
+
+
 def threshold_velocity(v_col, mean_f_gro) -> float | None:
     """The first v_col at which <f_gro> falls from > 0 to <= 0 (log-linear interpolation)."""
     v = np.asarray(v_col, dtype=float)
@@ -117,25 +127,20 @@ def summarise(campaign, plot: bool = True, include_cap: bool = False) -> dict:
     table, curves, cumulative = [], defaultdict(lambda: ([], [])), {}
     counts = defaultdict(list)
     for (name, v), runs in sorted(groups.items()):
-        by_b2 = defaultdict(list)                       # average the seeds of one B_off^2
-        for o in runs:
-            by_b2[round(o["B_off"] ** 2, 12)].append(o)
-        b2 = np.array(sorted(by_b2))
-        n_tot = runs[0]["n_total"]
-        n_grid = np.arange(1, n_tot + 1)
-        f = [np.mean([o["growth_efficiency"] for o in by_b2[b]]) for b in b2]
-        lar = [np.mean([o["n_largest"] / o["n_total"] for o in by_b2[b]]) for b in b2]
-        cum = [np.mean([cumulative_on(n_grid, o["fragment_sizes"], o["N_cum"])
-                        for o in by_b2[b]], axis=0) for b in b2]
-        mean_f = float(b_off_average(b2, f))
+        n_grid = np.arange(1, runs[0]["n_total"] + 1)
+        mean_f = float(b_off_mean(runs, lambda o: o["growth_efficiency"]))
         table.append(dict(model=name, v_col=v, runs=len(runs), left_out=dropped[(name, v)],
-                          capped=capped[(name, v)], B_off2_values=len(b2),
-                          mean_f_gro=mean_f, mean_N_lar_over_N_total=float(b_off_average(b2, lar)),
+                          capped=capped[(name, v)],
+                          B_off2_values=len({round(o["B_off"] ** 2, 12) for o in runs}),
+                          mean_f_gro=mean_f,
+                          mean_N_lar_over_N_total=float(b_off_mean(
+                              runs, lambda o: o["n_largest"] / o["n_total"])),
                           E_imp_over_nk_Ebreak=runs[0]["E_imp_over_nk_Ebreak"]))
         curves[name][0].append(v)
         curves[name][1].append(mean_f)
         counts[name].append(len(runs))
-        cumulative[f"{name}, {v:g} m/s"] = (n_grid, b_off_average(b2, np.array(cum)))
+        cumulative[f"{name}, {v:g} m/s"] = (n_grid, b_off_mean(
+            runs, lambda o: cumulative_on(n_grid, o["fragment_sizes"], o["N_cum"])))
     thresholds = {name: threshold_velocity(v, f) for name, (v, f) in curves.items()}
     write_csv(campaign / "summary.csv", table)
     summary = dict(runs=len(outcomes), left_out=left_out, include_cap=include_cap, table=table,

@@ -108,6 +108,8 @@ class PairJKRDT : public Pair {
   static constexpr double BINS_OUTGROWN = 1.25;
   // cutneigh: the neighbor cutoff (Neighbor's cutneighmax once it is set up)
   void fit_bins(double cutneigh);
+  // fit_bins when a run is set up, taking the side its neighbor bins will have
+  void start_bins(double cutneigh);
   // LAMMPS takes the neighbor bin size at a run's start only: true once the box has
   // outgrown this run's bins, so that a new run (which fix jkr/dt/settle asks for at its
   // next check) would bin the grains in BINS_PER_GRAIN per grain again

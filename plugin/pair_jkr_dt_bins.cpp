@@ -17,7 +17,7 @@
    (neigh_modify binsize, atom_modify sort N size) are left alone, as is
    everything with 'bins box'.
 
-   The sizes are fitted when a run is set up (init_style, before LAMMPS
+   The sizes are fitted when a run is set up (start_bins, before LAMMPS
    allocates its first bins: it never shrinks them) and before each
    reneighboring (the contact store's pre_exchange). The atom-sort bins take
    a new size at once, but LAMMPS's neighbor bins copy theirs at a run's
@@ -87,4 +87,13 @@ void PairJKRDT::fit_bins(double cutneigh)
   bin_size_set = size;
   if (bin_size_run > 0.0 && (size > 0.0 ? size : half_cut) > BINS_OUTGROWN * bin_size_run)
     bins_stale = true;
+}
+
+void PairJKRDT::start_bins(double cutneigh)
+{
+  fit_bins(cutneigh);
+  // the side LAMMPS's neighbor bins take for this run: the one fit_bins set, a user's,
+  // or LAMMPS's own
+  bin_size_run = neighbor->binsizeflag ? neighbor->binsize_user : 0.5 * cutneigh;
+  bins_stale = false;
 }

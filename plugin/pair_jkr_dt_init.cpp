@@ -102,9 +102,7 @@ void PairJKRDT::init_style()
   departed_bit = departed >= 0 ? group->bitmask[departed] : 0;
 
   neighbor->add_request(this, NeighConst::REQ_NEWTON_OFF);
-  fit_bins(cutmax + neighbor->skin);
-  bin_size_run = neighbor->binsizeflag ? neighbor->binsize_user : 0.5 * (cutmax + neighbor->skin);
-  bins_stale = false;
+  start_bins(cutmax + neighbor->skin);
 
   const int nthreads = nthreads_used();
   if (comm->me == 0 && nthreads != threads_logged)

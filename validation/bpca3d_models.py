@@ -37,7 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from common import campaign_study_parser, run_campaigns, save, study_paths
-from jkrdt.analysis.summary import b_off_average, cumulative_on, summarise, threshold_velocity
+from jkrdt.analysis.summary import b_off_mean, cumulative_on, summarise, threshold_velocity
 from jkrdt.analysis.tables import write_csv
 from jkrdt import rundir
 
@@ -78,13 +78,8 @@ def model_curve(where: Path, n_total: int) -> dict:
     grid = np.arange(1, n_total + 1)
     cumulative = {}
     for v in sorted({o["v_col"] for o in complete}):
-        by_b2 = {}
-        for o in complete:
-            if o["v_col"] == v:
-                by_b2.setdefault(round(o["B_off"] ** 2, 12), []).append(
-                    cumulative_on(grid, o["fragment_sizes"], o["N_cum"]))
-        b2 = sorted(by_b2)
-        cumulative[v] = b_off_average(b2, np.array([np.mean(by_b2[b], axis=0) for b in b2]))
+        cumulative[v] = b_off_mean([o for o in complete if o["v_col"] == v],
+                                   lambda o: cumulative_on(grid, o["fragment_sizes"], o["N_cum"]))
     v_fra = threshold_velocity([r["v_col"] for r in table], [r["mean_f_gro"] for r in table])
     return dict(v_col=[r["v_col"] for r in table], mean_f_gro=[r["mean_f_gro"] for r in table],
                 runs=[r["runs"] for r in table], capped=[r["capped"] for r in table],

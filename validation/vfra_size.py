@@ -35,16 +35,15 @@ from pathlib import Path
 
 import numpy as np
 
-from bpca3d_models import MODELS
+from bpca3d_models import FULL as SMALLER_PLAN, MODELS
 from common import HERE, campaign_study_parser, loop_seconds, run_campaigns, save, study_paths
 from jkrdt import rundir
-from jkrdt.analysis.summary import b_off_average, threshold_velocity
+from jkrdt.analysis.summary import b_off_mean, threshold_velocity
 from jkrdt.analysis.tables import read_csv, write_csv
 from jkrdt.stopping import COMPLETE
 
 #: max |dE| / E_imp that each run's dt is chosen for
 TOLERANCE = 1e-3
-B_OFF2 = [0.0, 0.25, 0.5, 0.75]
 #: each model's speeds (the paper's grid) around its v_fra at 2 x 1000 grains (frictional
 #: 54, damped frictional 82, frictionless 22, damped frictionless above 100 m/s) and the
 #: paper's at 10^5 (60, 50, 30, 45), in the order the models are run
@@ -54,7 +53,7 @@ GRIDS = {"frictionless, T_vis 6 ps": [50.1, 63.1, 79.4, 100.0, 125.9],
          "frictionless": [15.8, 20.0, 25.1, 31.6]}
 QUICK = dict(sizes=[24], grids={"frictional": [10.0, 39.8, 100.0],
                                 "frictionless": [10.0, 39.8, 100.0]}, b_off2=[0.0, 0.5])
-FULL = dict(sizes=[5000], grids=GRIDS, b_off2=B_OFF2)
+FULL = dict(sizes=[5000], grids=GRIDS, b_off2=SMALLER_PLAN["b_off2"])
 SEEDS = (1, 2)              # phase 1, phase 2
 #: the committed runs of the smaller sizes (validation/bpca3d_models.py)
 SMALLER = HERE / "bpca3d_models" / "runs.csv"
@@ -83,8 +82,8 @@ def curve(rows: list[dict]) -> dict:
     the 3D paper), with the two grid speeds that bracket v_fra."""
     done = [r for r in rows if r["stop_reason"] in COMPLETE]
     v = sorted({r["v_col"] for r in done})
-    f = [b_weighted([(round(r["B_off"] ** 2, 12), r["growth_efficiency"])
-                     for r in done if r["v_col"] == x]) for x in v]
+    f = [float(b_off_mean([r for r in done if r["v_col"] == x],
+                          lambda r: r["growth_efficiency"])) for x in v]
     bracket = next(([v[k], v[k + 1]] for k in range(len(v) - 1) if f[k] > 0 >= f[k + 1]),
                    None)
     return dict(v_col=v, mean_f_gro=f, runs=[sum(r["v_col"] == x for r in done) for x in v],
@@ -97,14 +96,6 @@ def seed_spread(rows: list[dict]) -> list[float]:
     found = [curve([r for r in rows if r["seed"] == seed])["v_fra"]
              for seed in sorted({r["seed"] for r in rows})]
     return [v for v in found if v is not None]
-
-
-def b_weighted(points: list[tuple[float, float]]) -> float:
-    """The B_off-weighted average of (B_off^2, value) points, the seeds of one B_off^2
-    averaged first (eq. 1 of the 3D paper, ``summary.b_off_average``)."""
-    b2 = sorted({p[0] for p in points})
-    return float(b_off_average(b2, np.array([np.mean([x for b, x in points if b == c])
-                                             for c in b2])))
 
 
 def outcome_rows(home: Path, n: int, model: str) -> list[dict]:
@@ -129,9 +120,10 @@ def size_trend(rows: list[dict]) -> dict:
             at = [r for r in mine if r["size"] == size]
             c = curve(at)
             seeds = seed_spread(at)
+            found = c["v_fra"] is not None
             points.append(dict(n_total=2 * size, v_fra=c["v_fra"], bracket=c["bracket"],
-                               low=min(seeds + [c["v_fra"]]) if c["v_fra"] else None,
-                               high=max(seeds + [c["v_fra"]]) if c["v_fra"] else None,
+                               low=min(seeds + [c["v_fra"]]) if found else None,
+                               high=max(seeds + [c["v_fra"]]) if found else None,
                                fastest=c["v_col"][-1]))
         placed = [p for p in points if p["v_fra"] is not None]
         fit = None
@@ -180,8 +172,9 @@ def figure(trend: dict, results: Path) -> list[Path]:
     return save(fig, results, "fig_vfra_size")
 
 
-def run_model(model: str, n: int, plan: dict, runs: Path, ranks: int) -> Path:
-    """Both phases of one model at 2 x ``n`` grains; returns the model's directory."""
+def run_model(model: str, n: int, plan: dict, runs: Path, ranks: int) -> tuple[Path, list]:
+    """Both phases of one model at 2 x ``n`` grains; returns the model's directory and
+    the speeds of phase 2."""
     grid = plan["grids"][model]
     home = runs / f"n{n}" / model.replace(", ", "_").replace(" ", "_")
     run_campaigns({f"seed{SEEDS[0]}": spec(model, n, grid, plan["b_off2"], SEEDS[0])},
@@ -189,7 +182,7 @@ def run_model(model: str, n: int, plan: dict, runs: Path, ranks: int) -> Path:
     second = nearest_two(curve(outcome_rows(home / f"seed{SEEDS[0]}", n, model)))
     run_campaigns({f"seed{SEEDS[1]}": spec(model, n, second, plan["b_off2"], SEEDS[1])},
                   home, ranks)
-    return home
+    return home, second
 
 
 def main(argv=None) -> int:
@@ -206,12 +199,12 @@ def main(argv=None) -> int:
     for n in plan["sizes"]:
         sizes[str(n)] = {}
         for model in plan["grids"]:
-            home = run_model(model, n, plan, runs, args.np)
+            home, second = run_model(model, n, plan, runs, args.np)
             mine = outcome_rows(home, n, model)
             rows += mine
             c = curve(mine)
             c.update(seeds_v_fra=seed_spread(mine),
-                     seed_2_at=nearest_two(curve([r for r in mine if r["seed"] == SEEDS[0]])),
+                     seed_2_at=second,
                      paper_v_fra=MODELS[model][2],
                      stop_reasons={k: sum(r["stop_reason"] == k for r in mine)
                                    for k in sorted({r["stop_reason"] for r in mine})},
