@@ -186,6 +186,28 @@ def test_the_size_study_places_v_fra_and_runs_seed_2_where_it_lies(tmp_path):
     assert at["frictionless"]["v_fra"] < at["frictional"]["v_fra"]
 
 
+def test_a_grid_that_misses_v_fra_is_extended_along_the_papers_speeds():
+    # at 2 x 5000 the damped frictionless <f_gro> was <= 0 already at the slowest speed of
+    # the grid that 2 x 1000 placed (50.1 m/s): the study then adds the paper's next speed,
+    # 10^(1 + 0.1 k), below it; above the fastest if <f_gro> is still > 0 there; none once
+    # the grid brackets v_fra or the step would leave the paper's range (10-125.9 m/s)
+    sys.path.insert(0, str(ROOT / "validation"))
+    try:
+        from vfra_size import curve, next_speed
+    finally:
+        sys.path.pop(0)
+
+    def rows(f_by_v):
+        return [dict(v_col=v, B_off=0.0, seed=1, growth_efficiency=f, stop_reason="settled")
+                for v, f in f_by_v.items()]
+
+    assert next_speed(curve(rows({50.1: -0.01, 63.1: -0.1, 100.0: -0.05}))) == 39.8
+    assert next_speed(curve(rows({50.1: 0.3, 79.4: 0.1, 100.0: 0.02}))) == 125.9
+    assert next_speed(curve(rows({39.8: 0.2, 50.1: -0.01, 63.1: -0.1}))) is None
+    assert next_speed(curve(rows({10.0: -0.2, 12.6: -0.3}))) is None
+    assert next_speed(curve(rows({100.0: 0.2, 125.9: 0.1}))) is None
+
+
 def test_the_size_trend_places_v_fra_as_the_smaller_study_did():
     # validation/vfra_size.py takes the committed runs of bpca3d_models (2 x 100, 250,
     # 1000) into its trend of v_fra against N: from those rows it must find the v_fra that

@@ -7,11 +7,14 @@ brackets each model's v_fra as the smaller sizes place it (GRIDS), at B_off^2 = 
 6/12, 9/12:
 
   phase 1   seed 1 at every speed of the model's grid;
-  phase 2   seed 2 at the two speeds of the grid on either side of phase 1's v_fra.
+  extend    if <f_gro> of seed 1 does not cross 0 on the grid (v_fra has moved outside it
+            with N), seed 1 at the paper's next speed beyond the grid on the side where
+            v_fra lies, one speed at a time (at most EXTEND, within 10-125.9 m/s);
+  phase 2   seed 2 at the two speeds on either side of seed 1's v_fra.
 
-Each model's phases are campaigns of their own (``RUNS/n<N>/<model>/seed<k>``), run one
-after the other, damped models first (their gap to the paper is the open question), and
-a second call resumes them. Every run ends by the settle rule, its dt chosen by
+Each model's phases are campaigns of their own (``RUNS/n<N>/<model>/seed<k>``, an
+extension ``seed1_v<speed>``), run one after the other, damped models first (their gap to
+the paper is the open question), and a second call resumes them. Every run ends by the settle rule, its dt chosen by
 ``--dt auto`` for max |dE| / E_imp <= 1e-3 (TOLERANCE): the trade study
 (benchmarks/tradeoff) found no outcome moving beyond its scatter up to 0.2 t_c, where the
 worst run's error was 6.5e-3.
@@ -51,9 +54,14 @@ GRIDS = {"frictionless, T_vis 6 ps": [50.1, 63.1, 79.4, 100.0, 125.9],
          "frictional, T_vis 6 ps": [50.1, 63.1, 79.4, 100.0],
          "frictional": [39.8, 50.1, 63.1, 79.4],
          "frictionless": [15.8, 20.0, 25.1, 31.6]}
+#: at most this many speeds added beyond a grid that does not bracket v_fra
+EXTEND = 3
 QUICK = dict(sizes=[24], grids={"frictional": [10.0, 39.8, 100.0],
-                                "frictionless": [10.0, 39.8, 100.0]}, b_off2=[0.0, 0.5])
-FULL = dict(sizes=[5000], grids=GRIDS, b_off2=SMALLER_PLAN["b_off2"])
+                                "frictionless": [10.0, 39.8, 100.0]}, b_off2=[0.0, 0.5],
+             extend=0)
+FULL = dict(sizes=[5000], grids=GRIDS, b_off2=SMALLER_PLAN["b_off2"], extend=EXTEND)
+#: the paper's speeds are 10^(1 + 0.1 k) m/s, k = 0 ... 10; one step more each way at most
+SLOWEST, FASTEST = 10.0, 125.9
 SEEDS = (1, 2)              # phase 1, phase 2
 #: the committed runs of the smaller sizes (validation/bpca3d_models.py)
 SMALLER = HERE / "bpca3d_models" / "runs.csv"
@@ -74,6 +82,18 @@ def nearest_two(c: dict) -> list[float]:
         return c["bracket"]
     v, f = c["v_col"], c["mean_f_gro"]
     return v[:2] if f[0] <= 0 else v[-2:]
+
+
+def next_speed(c: dict) -> float | None:
+    """The paper's grid speed one step beyond curve ``c``'s speeds toward its v_fra: below
+    the slowest if <f_gro> <= 0 there already, above the fastest if it is still > 0; None
+    if ``c`` brackets v_fra or the step would leave SLOWEST-FASTEST."""
+    if c["bracket"] is not None:
+        return None
+    v, f = c["v_col"], c["mean_f_gro"]
+    k = round(10 * np.log10(v[0])) - 1 if f[0] <= 0 else round(10 * np.log10(v[-1])) + 1
+    speed = round(10 ** (k / 10), 1)
+    return speed if SLOWEST <= speed <= FASTEST else None
 
 
 def curve(rows: list[dict]) -> dict:
@@ -177,9 +197,17 @@ def run_model(model: str, n: int, plan: dict, runs: Path, ranks: int) -> tuple[P
     the speeds of phase 2."""
     grid = plan["grids"][model]
     home = runs / f"n{n}" / model.replace(", ", "_").replace(" ", "_")
-    run_campaigns({f"seed{SEEDS[0]}": spec(model, n, grid, plan["b_off2"], SEEDS[0])},
-                  home, ranks)
-    second = nearest_two(curve(outcome_rows(home / f"seed{SEEDS[0]}", n, model)))
+    first = f"seed{SEEDS[0]}"
+    run_campaigns({first: spec(model, n, grid, plan["b_off2"], SEEDS[0])}, home, ranks)
+    rows = outcome_rows(home / first, n, model)
+    for _ in range(plan["extend"]):
+        speed = next_speed(curve(rows))
+        if speed is None:
+            break
+        name = f"{first}_v{speed:g}"
+        run_campaigns({name: spec(model, n, [speed], plan["b_off2"], SEEDS[0])}, home, ranks)
+        rows += outcome_rows(home / name, n, model)
+    second = nearest_two(curve(rows))
     run_campaigns({f"seed{SEEDS[1]}": spec(model, n, second, plan["b_off2"], SEEDS[1])},
                   home, ranks)
     return home, second
