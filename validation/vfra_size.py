@@ -14,16 +14,20 @@ brackets each model's v_fra as the smaller sizes place it (GRIDS), at B_off^2 = 
 
 Each model's phases are campaigns of their own (``RUNS/n<N>/<model>/seed<k>``, an
 extension ``seed1_v<speed>``), run one after the other, damped models first (their gap to
-the paper is the open question), and a second call resumes them. Every run ends by the settle rule, its dt chosen by
-``--dt auto`` for max |dE| / E_imp <= 1e-3 (TOLERANCE): the trade study
-(benchmarks/tradeoff) found no outcome moving beyond its scatter up to 0.2 t_c, where the
-worst run's error was 6.5e-3.
+the paper is the open question), and a second call resumes them. ``--paper-size`` runs
+instead the 12 collisions at the paper's 2 x 50000 grains (PAPER_SIZE), one campaign per
+model and offset. Every run ends by the settle rule, its dt chosen by ``--dt auto`` for
+max |dE| / E_imp <= 1e-3 (TOLERANCE): the trade study (benchmarks/tradeoff) found no
+outcome moving beyond its scatter up to 0.2 t_c, where the worst run's error was 6.5e-3.
 
-Writes RESULTS (default validation/vfra_size/): runs.csv (every run, with its loop time)
-and summary.json (per size and model: <f_gro> against v_col, v_fra with its bracket, the
-compute spent).
+Writes RESULTS (default validation/vfra_size/), from every finished run below RUNS
+whichever call ran it: runs.csv (every run, with its loop time), summary.json (per size
+and model: <f_gro> against v_col, v_fra with its bracket, the compute spent; the trend of
+v_fra against N; the paper-size collisions) and fig_vfra_size.
 
     ./run validate vfra_size                    # 2 x 5000, 2 ranks: 100 runs, hours of both cores
+    ./run validate vfra_size --models "frictional, T_vis 6 ps"
+    ./run validate vfra_size --paper-size 0 0.5  # 2 x 50000: B_off^2 0 and 6/12 of PAPER_SIZE
     ./run validate vfra_size --sizes 10000
     ./run validate vfra_size --quick            # 2 x 24 grains, two models (tests)
 """
@@ -60,6 +64,12 @@ QUICK = dict(sizes=[24], grids={"frictional": [10.0, 39.8, 100.0],
                                 "frictionless": [10.0, 39.8, 100.0]}, b_off2=[0.0, 0.5],
              extend=0)
 FULL = dict(sizes=[5000], grids=GRIDS, b_off2=SMALLER_PLAN["b_off2"], extend=EXTEND)
+#: the 3D paper's size (issue 23, item 2): both damped models at 63.1 m/s, where the paper
+#: has them fragmenting and 2 x 1000 grains still grow, and the undamped frictionless model
+#: at 39.8 m/s (the paper's Fig. 1); seed 1, B_off^2 0 and 6/12 of every model first
+PAPER_SIZE = dict(n=50000, speeds={"frictionless, T_vis 6 ps": 63.1,
+                                   "frictional, T_vis 6 ps": 63.1, "frictionless": 39.8},
+                  b_off2=[0.0, 0.5, 0.25, 0.75])
 #: the paper's speeds are 10^(1 + 0.1 k) m/s, k = 0 ... 10; one step more each way at most
 SLOWEST, FASTEST = 10.0, 125.9
 SEEDS = (1, 2)              # phase 1, phase 2
@@ -129,9 +139,10 @@ def outcome_rows(home: Path, n: int, model: str) -> list[dict]:
 
 
 def size_trend(rows: list[dict]) -> dict:
-    """Per model: v_fra at each size with the range of its seeds' own v_fra, and the fit
-    v_fra = a + b log10(N_total) over the sizes that place it, with its value at the
-    paper's N_total = 10^5 (None where fewer than two sizes place v_fra)."""
+    """Per model: v_fra at each size with the range of its seeds' own v_fra (or, where the
+    speeds run do not place it, the bound they give: above the fastest or below the
+    slowest), and the fit v_fra = a + b log10(N_total) over the sizes that place it, with
+    its value at the paper's N_total = 10^5 (None where fewer than two sizes place v_fra)."""
     out = {}
     for model in MODELS:
         mine = [r for r in rows if r["model"] == model]
@@ -144,7 +155,9 @@ def size_trend(rows: list[dict]) -> dict:
             points.append(dict(n_total=2 * size, v_fra=c["v_fra"], bracket=c["bracket"],
                                low=min(seeds + [c["v_fra"]]) if found else None,
                                high=max(seeds + [c["v_fra"]]) if found else None,
-                               fastest=c["v_col"][-1]))
+                               bound=None if found else (
+                                   ("below", c["v_col"][0]) if c["mean_f_gro"][0] <= 0
+                                   else ("above", c["v_col"][-1]))))
         placed = [p for p in points if p["v_fra"] is not None]
         fit = None
         if len(placed) >= 2:
@@ -155,16 +168,17 @@ def size_trend(rows: list[dict]) -> dict:
     return out
 
 
-def figure(trend: dict, results: Path) -> list[Path]:
+def figure(trend: dict, paper_size: dict, results: Path) -> list[Path]:
     """fig_vfra_size: v_fra against N_total per model, the seeds' range as error bars,
-    sizes whose grid reaches no v_fra as open triangles at its fastest speed, the fits to
-    10^5 and the paper's values."""
+    sizes whose speeds place no v_fra as open triangles at the bound they give (up: above
+    the fastest speed, down: below the slowest), the fits to 10^5 and the paper's values; at 10^5, where all four offsets of PAPER_SIZE ran, a
+    bound: v_fra below its speed (<f_gro> <= 0 there, a triangle down) or above it (up)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     colours = dict(zip(MODELS, ("C0", "C1", "C3", "C2")))
-    fig, ax = plt.subplots(figsize=(8, 5), constrained_layout=True)
+    fig, ax = plt.subplots(figsize=(11, 5), constrained_layout=True)
     for k, (model, t) in enumerate(trend.items()):
         c = colours[model]
         placed = [p for p in t["points"] if p["v_fra"] is not None]
@@ -173,30 +187,44 @@ def figure(trend: dict, results: Path) -> list[Path]:
             v = np.array([p["v_fra"] for p in placed])
             err = [v - [p["low"] for p in placed], [p["high"] for p in placed] - v]
             ax.errorbar(n, v, yerr=err, fmt="o", color=c, capsize=3, label=model)
-        above = [p for p in t["points"] if p["v_fra"] is None]
-        if above:
-            ax.plot([p["n_total"] * 1.05 ** k for p in above],      # side by side
-                    [p["fastest"] for p in above], "^",
-                    color=c, mfc="none", ms=9, label=f"{model}: above the fastest speed run")
+        for side, marker in (("above", "^"), ("below", "v")):
+            bounds = [p for p in t["points"] if p["bound"] and p["bound"][0] == side]
+            if bounds:
+                ax.plot([p["n_total"] * 1.05 ** k for p in bounds],      # side by side
+                        [p["bound"][1] for p in bounds], marker, color=c, mfc="none", ms=9,
+                        label=f"{model}: {side} the {'fastest' if side == 'above' else 'slowest'}"
+                              " speed run")
         if t["fit"]:
             x = np.logspace(np.log10(min(p["n_total"] for p in placed)), 5, 50)
             ax.plot(x, t["fit"]["a"] + t["fit"]["b"] * np.log10(x), "--", color=c, lw=1)
         ax.plot([1e5], [t["paper_v_fra"]], "*", ms=12, color=c, mec="k", mew=0.5)
+        large = paper_size.get(model, {})
+        if large.get("mean_f_gro") is not None:
+            below = large["mean_f_gro"] <= 0
+            ax.plot([1e5 * 1.05 ** k], [large["v_col"]], "v" if below else "^", color=c,
+                    ms=9, label=f"{model}, 2 x 50000: <f_gro> {large['mean_f_gro']:+.2f} "
+                                f"at {large['v_col']:g} m/s")
     ax.set_xscale("log")
     ax.set_xlabel("N_total (grains in both aggregates)")
     ax.set_ylabel("v_fra (m/s)")
     ax.set_title("v_fra against size: points this study (error bars: the seeds), dashed "
-                 "fits a + b log N,\nstars the paper at 10^5, open triangles: no v_fra up to the "
-                 "fastest speed run", fontsize=8)
-    ax.legend(fontsize=8)
+                 "fits a + b log N, stars the paper at 10^5,\ntriangles: v_fra not placed, above "
+                 "(up) or below (down) the speeds run; filled at 10^5: the paper-size runs' "
+                 "bound", fontsize=8)
+    ax.set_ylim(0, 1.1 * FASTEST)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1))     # beside, not over
     return save(fig, results, "fig_vfra_size")
 
 
-def run_model(model: str, n: int, plan: dict, runs: Path, ranks: int) -> tuple[Path, list]:
-    """Both phases of one model at 2 x ``n`` grains; returns the model's directory and
-    the speeds of phase 2."""
+def model_home(runs: Path, n: int, model: str) -> Path:
+    """Where the campaigns of ``model`` at 2 x ``n`` grains go."""
+    return runs / f"n{n}" / model.replace(", ", "_").replace(" ", "_")
+
+
+def run_model(model: str, n: int, plan: dict, runs: Path, ranks: int) -> None:
+    """Phase 1, its extension and phase 2 of one model at 2 x ``n`` grains."""
     grid = plan["grids"][model]
-    home = runs / f"n{n}" / model.replace(", ", "_").replace(" ", "_")
+    home = model_home(runs, n, model)
     first = f"seed{SEEDS[0]}"
     run_campaigns({first: spec(model, n, grid, plan["b_off2"], SEEDS[0])}, home, ranks)
     rows = outcome_rows(home / first, n, model)
@@ -207,50 +235,102 @@ def run_model(model: str, n: int, plan: dict, runs: Path, ranks: int) -> tuple[P
         name = f"{first}_v{speed:g}"
         run_campaigns({name: spec(model, n, [speed], plan["b_off2"], SEEDS[0])}, home, ranks)
         rows += outcome_rows(home / name, n, model)
-    second = nearest_two(curve(rows))
-    run_campaigns({f"seed{SEEDS[1]}": spec(model, n, second, plan["b_off2"], SEEDS[1])},
-                  home, ranks)
-    return home, second
+    run_campaigns({f"seed{SEEDS[1]}": spec(model, n, nearest_two(curve(rows)),
+                                           plan["b_off2"], SEEDS[1])}, home, ranks)
+
+
+def run_paper_size(runs: Path, ranks: int, b_off2: list[float]) -> None:
+    """The 12 collisions of PAPER_SIZE at 2 x 50000 grains, seed 1, the offsets ``b_off2``
+    of each model before the next offsets of any (one campaign per model and offsets)."""
+    n = PAPER_SIZE["n"]
+    for b2 in b_off2:
+        for model, v in PAPER_SIZE["speeds"].items():
+            run_campaigns({f"v{v:g}_b2_{b2:.4f}": spec(model, n, [v], [b2], SEEDS[0])},
+                          model_home(runs, n, model), ranks)
+
+
+def size_summary(mine: list[dict], model: str) -> dict:
+    """One model at one size: its curve, v_fra, the seeds' v_fra, where seed 2 ran, how the
+    runs ended, their worst energy error and the compute they took."""
+    c = curve(mine)
+    c.update(seeds_v_fra=seed_spread(mine),
+             seed_2_at=sorted({r["v_col"] for r in mine if r["seed"] == SEEDS[1]}),
+             paper_v_fra=MODELS[model][2],
+             stop_reasons={k: sum(r["stop_reason"] == k for r in mine)
+                           for k in sorted({r["stop_reason"] for r in mine})},
+             energy_error_max=max(r["energy_error"] for r in mine),
+             core_hours=sum(r["loop_seconds"] for r in mine) / 3600)
+    return c
+
+
+def paper_size_summary(rows: list[dict]) -> dict:
+    """Per model at 2 x 50000: f_gro per B_off^2 and, once all four offsets ran, <f_gro>
+    (eq. 1), with the paper's v_fra it is read against."""
+    out = {}
+    for model, v in PAPER_SIZE["speeds"].items():
+        mine = [r for r in rows if r["model"] == model and r["stop_reason"] in COMPLETE]
+        if not mine:
+            continue
+        out[model] = dict(
+            v_col=v, paper_v_fra=MODELS[model][2],
+            f_gro={f"{r['B_off'] ** 2:.4f}": r["growth_efficiency"] for r in mine},
+            mean_f_gro=(float(b_off_mean(mine, lambda r: r["growth_efficiency"]))
+                        if len(mine) == len(PAPER_SIZE["b_off2"]) else None),
+            energy_error_max=max(r["energy_error"] for r in mine),
+            core_hours=sum(r["loop_seconds"] for r in mine) / 3600)
+    return out
 
 
 def main(argv=None) -> int:
     p = campaign_study_parser(__doc__)
     p.add_argument("--sizes", type=int, nargs="+", default=None,
                    help="grains per aggregate (default: 5000)")
+    p.add_argument("--models", nargs="+", default=None, metavar="MODEL",
+                   help="run only these models at the sizes (default: all, in GRIDS' order); "
+                        "the summary takes every model's finished runs")
+    p.add_argument("--paper-size", nargs="*", type=float, default=None, metavar="B_OFF2",
+                   help="run the 12 collisions at 2 x 50000 (PAPER_SIZE) instead of the "
+                        "sizes, at these B_off^2 (default all four)")
     args = p.parse_args(argv)
     plan = dict(QUICK if args.quick else FULL)
     if args.sizes:
         plan["sizes"] = args.sizes
+    unknown = sorted(set(args.models or []) - set(plan["grids"]))
+    if unknown:
+        p.error(f"unknown model {unknown[0]!r}: give one of {list(plan['grids'])}")
+    if args.paper_size is not None and not set(args.paper_size) <= set(PAPER_SIZE["b_off2"]):
+        p.error(f"--paper-size takes B_off^2 of {PAPER_SIZE['b_off2']}")
     runs, results = study_paths(args, "vfra_size")
     t0 = time.time()
+    if args.paper_size is not None:
+        run_paper_size(runs, args.np, args.paper_size or PAPER_SIZE["b_off2"])
+    else:
+        for n in plan["sizes"]:
+            for model in args.models or plan["grids"]:
+                run_model(model, n, plan, runs, args.np)
+    # every finished run below RUNS goes into the tables, whichever call ran it
     rows, sizes = [], {}
     for n in plan["sizes"]:
-        sizes[str(n)] = {}
         for model in plan["grids"]:
-            home, second = run_model(model, n, plan, runs, args.np)
-            mine = outcome_rows(home, n, model)
-            rows += mine
-            c = curve(mine)
-            c.update(seeds_v_fra=seed_spread(mine),
-                     seed_2_at=second,
-                     paper_v_fra=MODELS[model][2],
-                     stop_reasons={k: sum(r["stop_reason"] == k for r in mine)
-                                   for k in sorted({r["stop_reason"] for r in mine})},
-                     energy_error_max=max(r["energy_error"] for r in mine),
-                     core_hours=sum(r["loop_seconds"] for r in mine) / 3600)
-            sizes[str(n)][model] = c
-            write_csv(results / "runs.csv", rows)          # as each model finishes
+            mine = outcome_rows(model_home(runs, n, model), n, model)
+            if mine:
+                rows += mine
+                sizes.setdefault(str(n), {})[model] = size_summary(mine, model)
+    large = [r for model in PAPER_SIZE["speeds"] for r in
+             outcome_rows(model_home(runs, PAPER_SIZE["n"], model), PAPER_SIZE["n"], model)]
+    write_csv(results / "runs.csv", rows + large)
     # the size trend: the committed smaller sizes of bpca3d_models with these (not in the
     # quick variant, whose sizes are its own)
     before = [] if args.quick else [r for r in read_csv(SMALLER) if r["size"] not in
                                     plan["sizes"]]
     trend = size_trend(before + rows)
-    figure(trend, results)
+    paper_size = paper_size_summary(large)
+    figure(trend, paper_size, results)
     summary = dict(plan=plan, tolerance=TOLERANCE, ranks=args.np,
                    seconds_this_call=time.time() - t0, load=os.getloadavg()[0], sizes=sizes,
-                   trend=trend)
+                   trend=trend, paper_size=paper_size)
     (results / "summary.json").write_text(json.dumps(summary, indent=2, default=float) + "\n")
-    print(json.dumps(sizes, indent=1, default=float))
+    print(json.dumps(dict(sizes=sizes, paper_size=paper_size), indent=1, default=float))
     return 0
 
 
