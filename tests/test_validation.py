@@ -10,6 +10,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from jkrdt.analysis.tables import read_csv
@@ -186,6 +187,29 @@ def test_the_size_study_places_v_fra_and_runs_seed_2_where_it_lies(tmp_path):
         assert c["seeds_v_fra"] and all(grid[0] < v < grid[-1] for v in c["seeds_v_fra"])
     # the 3D paper's order: without friction the aggregates break at lower speed
     assert at["frictionless"]["v_fra"] < at["frictional"]["v_fra"]
+
+
+def test_the_damped_dt_study_compares_two_steps_whose_ledgers_close(tmp_path):
+    # validation/damped_dt.py --quick: damped frictionless 2 x 24 ice BPCAs at 63.1 m/s,
+    # B_off^2 3/12, 3 seeds, at dt = 0.014 t_c and at --dt auto for 1e-3. The auto step
+    # is timestep.choose's for that scene, and larger (else the study compares nothing);
+    # every run's energy ledger closes to the tolerance (damping is booked, not lost); the
+    # comparison is the ensembles' difference against twice its standard error
+    from jkrdt import timestep
+
+    results = run_quick("damped_dt", tmp_path)
+    summary = json.loads((results / "summary.json").read_text())
+    runs = read_csv(results / "runs.csv")
+    assert summary["runs_finished"] == 6
+    want, _ = timestep.choose(1e-3, 63.1, scales(ICE, 1e-7).v0,
+                              model="frictionless", n_total=48, damped=True)
+    assert summary["dt_auto_over_tc"] == [pytest.approx(want, rel=1e-12)]
+    assert want > 0.014
+    assert max(r["energy_error"] for r in runs) < 1e-3
+    f = summary["results"]["frictionless, T_vis 6 ps"]["0.2500"]["f_gro"]
+    mine = [r["growth_efficiency"] for r in runs if r["step"] == "dt auto"]
+    assert f["at_auto"][0] == pytest.approx(np.mean(mine), abs=1e-12)
+    assert f["agree"] == (abs(f["difference"]) <= 2 * f["se"])
 
 
 def test_a_grid_that_misses_v_fra_is_extended_along_the_papers_speeds():

@@ -1,0 +1,99 @@
+"""Does ``--dt auto`` leave the damped models' outcomes unchanged? An ensemble at two steps.
+
+``validation/vfra_size.py`` runs every collision at the dt that ``jkrdt setup --dt auto``
+chooses for max |dE| / E_imp <= 1e-3, and the smaller sizes of ``bpca3d_models`` ran at
+dt = 0.014 t_c. The trade study (benchmarks/tradeoff) showed the outcomes unchanged up to
+0.2 t_c for the undamped models only; with eq. (A.5)'s damping a contact has a time scale
+of its own, and --dt auto takes about twice 0.014 t_c at 63.1 m/s. Before the damped
+models' v_fra at 2 x 5000 is read against 2 x 1000 this study asks whether dt alone moves
+it: both damped models at 2 x 1000 grains, 63.1 m/s, the two offsets whose f_gro decides
+<f_gro> there (B_off^2 = 3/12, 6/12), SEEDS seeds, once at dt = 0.014 t_c and once at
+--dt auto (1e-3). Collisions are chaotic, so the two are compared as ensembles: per model
+and offset, the means of f_gro and N_lar / N with their standard errors, and the
+difference against twice its standard error.
+
+Writes RESULTS (default validation/damped_dt/): runs.csv and summary.json.
+
+    ./run validate damped_dt               # 2 models x 2 offsets x 6 seeds x 2 dt, 2 ranks
+    ./run validate damped_dt --quick       # 2 x 24 grains, 3 seeds (tests)
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+
+import numpy as np
+
+from bpca3d_models import MODELS
+from common import campaign_paths, campaign_study_parser, run_campaigns, study_paths
+from jkrdt.analysis.tables import write_csv
+from jkrdt.stopping import COMPLETE
+from vfra_size import TOLERANCE, model_home, outcome_rows
+
+#: the step of bpca3d_models' runs
+DT_FIXED = 0.014
+FULL = dict(n=1000, v_col=63.1, b_off2=[0.25, 0.5], seeds=[1, 2, 3, 4, 5, 6],
+            models=["frictionless, T_vis 6 ps", "frictional, T_vis 6 ps"])
+QUICK = dict(n=24, v_col=63.1, b_off2=[0.25], seeds=[1, 2, 3],
+             models=["frictionless, T_vis 6 ps"])
+STEPS = {"dt 0.014": dict(dt=DT_FIXED), "dt auto": dict(dt="auto", tolerance=TOLERANCE)}
+
+
+def spec(plan: dict, model: str, step: dict) -> dict:
+    kind, tvis, _ = MODELS[model]
+    return dict(kind="bpca", dim=3, n_tar=plan["n"], n_pro=plan["n"], material="ice",
+                material_overrides=dict(tvis=tvis), model=kind, v_col=[plan["v_col"]],
+                b_off2=plan["b_off2"], seeds=plan["seeds"], **step)
+
+
+def mean_se(values: list[float]) -> tuple[float, float]:
+    """The mean and its standard error (0 for one value)."""
+    a = np.asarray(values, dtype=float)
+    return float(a.mean()), float(a.std(ddof=1) / np.sqrt(len(a))) if len(a) > 1 else 0.0
+
+
+def compare(rows: list[dict], model: str, b2: float) -> dict:
+    """f_gro and N_lar / N of one model and offset at both steps, and whether they agree:
+    |difference| below twice its standard error."""
+    out = {}
+    for measure, value in (("f_gro", lambda r: r["growth_efficiency"]),
+                           ("N_lar_over_N", lambda r: r["n_largest"] / r["n_total"])):
+        at = {name: mean_se([value(r) for r in rows if r["model"] == model
+                             and r["step"] == name and abs(r["B_off"] ** 2 - b2) < 1e-9])
+              for name in STEPS}
+        (a, sa), (b, sb) = at["dt 0.014"], at["dt auto"]
+        se = float(np.hypot(sa, sb))
+        out[measure] = dict(at_0014=[a, sa], at_auto=[b, sb], difference=b - a,
+                            se=se, agree=bool(abs(b - a) <= 2 * se))
+    return out
+
+
+def main(argv=None) -> int:
+    p = campaign_study_parser(__doc__)
+    args = p.parse_args(argv)
+    plan = QUICK if args.quick else FULL
+    runs, results = study_paths(args, "damped_dt")
+    rows = []
+    for model in plan["models"]:
+        home = model_home(runs, plan["n"], model)
+        run_campaigns({name: spec(plan, model, step) for name, step in STEPS.items()},
+                      home, args.np)
+        for name, where in campaign_paths(STEPS, home).items():
+            rows += [dict(r, step=name) for r in outcome_rows(where, plan["n"], model)
+                     if r["stop_reason"] in COMPLETE]
+    write_csv(results / "runs.csv", rows)
+    summary = dict(plan=plan, steps=STEPS, results={
+        model: {f"{b2:.4f}": compare(rows, model, b2) for b2 in plan["b_off2"]}
+        for model in plan["models"]},
+        dt_auto_over_tc=sorted({r["dt_over_tc"] for r in rows if r["step"] == "dt auto"}),
+        energy_error_max={name: max(r["energy_error"] for r in rows if r["step"] == name)
+                          for name in STEPS},
+        runs_finished=len(rows))
+    (results / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    print(json.dumps(summary["results"], indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
