@@ -139,7 +139,8 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
     write_csv(run / rundir.FRAMES, rows)
     if plots:
         title = (f"{mat.name} {scene.kind.upper()} {n_tar}+{n_pro}, "
-                 f"v = {scene.v_col:g} m/s, B_off = {scene.b_off:g}, {scene.model}")
+                 f"v = {scene.v_col:g} m/s, B_off = {scene.b_off:g}, {scene.model}"
+                 + (f", T_vis = {mat.tvis * 1e12:g} ps" if mat.tvis > 0 else ""))
         when = f"{status.stop_reason} at step {last_step}"
         if "time_end" in out:
             when += (f", t = {out['time_end'] * 1e9:.0f} ns = {out['time_end_over_tc']:.0f} t_c; "
