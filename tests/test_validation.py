@@ -215,8 +215,9 @@ def test_the_damped_dt_study_compares_two_steps_whose_ledgers_close(tmp_path):
 def test_a_grid_that_misses_v_fra_is_extended_along_the_papers_speeds():
     # at 2 x 5000 the damped frictionless <f_gro> was <= 0 already at the slowest speed of
     # the grid that 2 x 1000 placed (50.1 m/s): the study then adds the paper's next speed,
-    # 10^(1 + 0.1 k), below it; above the fastest if <f_gro> is still > 0 there; none once
-    # the grid brackets v_fra or the step would leave the paper's range (10-125.9 m/s)
+    # 10^(1 + 0.1 k), below it; above the fastest if <f_gro> is > 0 at every speed; none
+    # once the slowest speed grows and a crossing is bracketed, or the step would leave the
+    # paper's range (10-125.9 m/s)
     sys.path.insert(0, str(ROOT / "validation"))
     try:
         from vfra_size import curve, next_speed
@@ -228,6 +229,10 @@ def test_a_grid_that_misses_v_fra_is_extended_along_the_papers_speeds():
                 for v, f in f_by_v.items()]
 
     assert next_speed(curve(rows({50.1: -0.01, 63.1: -0.1, 100.0: -0.05}))) == 39.8
+    # a curve near 0 that rises and falls again (one seed) still extends below: v_fra is
+    # the first speed at which <f_gro> falls to <= 0
+    assert next_speed(curve(rows({50.1: -0.01, 63.1: -0.1, 100.0: 0.001, 125.9: -0.2}))) \
+        == 39.8
     assert next_speed(curve(rows({50.1: 0.3, 79.4: 0.1, 100.0: 0.02}))) == 125.9
     assert next_speed(curve(rows({39.8: 0.2, 50.1: -0.01, 63.1: -0.1}))) is None
     assert next_speed(curve(rows({10.0: -0.2, 12.6: -0.3}))) is None

@@ -7,9 +7,10 @@ brackets each model's v_fra as the smaller sizes place it (GRIDS), at B_off^2 = 
 6/12, 9/12:
 
   phase 1   seed 1 at every speed of the model's grid;
-  extend    if <f_gro> of seed 1 does not cross 0 on the grid (v_fra has moved outside it
-            with N), seed 1 at the paper's next speed beyond the grid on the side where
-            v_fra lies, one speed at a time (at most EXTEND, within 10-125.9 m/s);
+  extend    if <f_gro> of seed 1 is <= 0 already at the grid's slowest speed, or > 0 at
+            every speed (v_fra has moved out of the grid with N), seed 1 at the paper's
+            next speed beyond the grid on that side, one speed at a time (at most EXTEND,
+            within 10-125.9 m/s);
   phase 2   seed 2 at the two speeds on either side of seed 1's v_fra.
 
 Each model's phases are campaigns of their own (``RUNS/n<N>/<model>/seed<k>``, an
@@ -23,7 +24,8 @@ outcome moving beyond its scatter up to 0.2 t_c, where the worst run's error was
 Writes RESULTS (default validation/vfra_size/), from every finished run below RUNS
 whichever call ran it: runs.csv (every run, with its loop time), summary.json (per size
 and model: <f_gro> against v_col, v_fra with its bracket, the compute spent; the trend of
-v_fra against N; the paper-size collisions) and fig_vfra_size.
+v_fra against N; the paper-size collisions), fig_vfra_size and fig_growth_size
+(<f_gro> against v_col per model, a line per size).
 
     ./run validate vfra_size                    # 2 x 5000, 2 ranks: 100 runs, hours of both cores
     ./run validate vfra_size --models "frictional, T_vis 6 ps"
@@ -95,13 +97,18 @@ def nearest_two(c: dict) -> list[float]:
 
 
 def next_speed(c: dict) -> float | None:
-    """The paper's grid speed one step beyond curve ``c``'s speeds toward its v_fra: below
-    the slowest if <f_gro> <= 0 there already, above the fastest if it is still > 0; None
-    if ``c`` brackets v_fra or the step would leave SLOWEST-FASTEST."""
-    if c["bracket"] is not None:
-        return None
+    """The paper's grid speed one step beyond curve ``c``'s speeds toward its v_fra, the
+    first speed at which <f_gro> falls to <= 0: below the slowest if <f_gro> <= 0 there
+    already (even if a later rise and fall brackets a crossing: a curve near 0 wanders
+    with one seed), above the fastest if it is > 0 everywhere; None if the slowest speed
+    grows and a crossing is bracketed, or the step would leave SLOWEST-FASTEST."""
     v, f = c["v_col"], c["mean_f_gro"]
-    k = round(10 * np.log10(v[0])) - 1 if f[0] <= 0 else round(10 * np.log10(v[-1])) + 1
+    if f[0] <= 0:
+        k = round(10 * np.log10(v[0])) - 1
+    elif c["bracket"] is None:
+        k = round(10 * np.log10(v[-1])) + 1
+    else:
+        return None
     speed = round(10 ** (k / 10), 1)
     return speed if SLOWEST <= speed <= FASTEST else None
 
@@ -217,6 +224,50 @@ def figure(trend: dict, paper_size: dict, results: Path) -> list[Path]:
     return save(fig, results, "fig_vfra_size")
 
 
+def growth_figure(rows: list[dict], paper_size: dict, results: Path) -> list[Path]:
+    """fig_growth_size: <f_gro> against v_col, one panel per model, one line per size
+    (darker = larger), the 2 x 50000 <f_gro> where all four offsets ran, and the paper's
+    v_fra: where each size's curve crosses 0, and how flat it is there."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.ticker import NullFormatter, ScalarFormatter
+
+    sizes = sorted({r["size"] for r in rows})
+    shade = {n: plt.cm.viridis(0.85 * (1 - k / max(1, len(sizes) - 1)))
+             for k, n in enumerate(sizes)}
+    fig, axes = plt.subplots(2, 2, figsize=(11, 7.5), sharex=True, sharey=True,
+                             constrained_layout=True)
+    for ax, model in zip(axes.flat, MODELS):
+        for n in sizes:
+            at = [r for r in rows if r["model"] == model and r["size"] == n]
+            if not at:
+                continue
+            c = curve(at)
+            label = f"2 x {n}: " + (f"v_fra {c['v_fra']:.3g} m/s" if c["v_fra"] else "no v_fra")
+            ax.semilogx(c["v_col"], c["mean_f_gro"], "o-", ms=3, color=shade[n],
+                        lw=1 + sizes.index(n) * 0.6, label=label)
+        large = paper_size.get(model, {})
+        if large.get("mean_f_gro") is not None:
+            ax.plot([large["v_col"]], [large["mean_f_gro"]], "s", color="k", ms=7,
+                    label=f"2 x {PAPER_SIZE['n']}: {large['mean_f_gro']:+.2f}")
+        ax.plot([MODELS[model][2]], [0], "v", color="C3", ms=10,
+                label=f"the paper's v_fra at 10^5: {MODELS[model][2]:g} m/s")
+        ax.axhline(0, color="0.7", lw=0.8)
+        ax.set_title(model, fontsize=9)
+        ax.legend(fontsize=7)
+    for ax in axes[1]:
+        ax.set_xticks([10, 20, 40, 60, 100])
+        ax.xaxis.set_major_formatter(ScalarFormatter())
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.set_xlabel("v_col (m/s)")
+    for ax in axes[:, 0]:
+        ax.set_ylabel("<f_gro> (eq. 1, B_off^2 0-9/12)")
+    fig.suptitle("3D BPCA paper Fig. 2 against size (ice): <f_gro> of each size, seeds "
+                 "averaged per offset", fontsize=10)
+    return save(fig, results, "fig_growth_size")
+
+
 def model_home(runs: Path, n: int, model: str) -> Path:
     """Where the campaigns of ``model`` at 2 x ``n`` grains go."""
     return runs / f"n{n}" / model.replace(", ", "_").replace(" ", "_")
@@ -327,6 +378,7 @@ def main(argv=None) -> int:
     trend = size_trend(before + rows)
     paper_size = paper_size_summary(large)
     figure(trend, paper_size, results)
+    growth_figure(before + rows, paper_size, results)
     summary = dict(plan=plan, tolerance=TOLERANCE, ranks=args.np,
                    seconds_this_call=time.time() - t0, load=os.getloadavg()[0], sizes=sizes,
                    trend=trend, paper_size=paper_size)
