@@ -209,9 +209,9 @@ def figure(trend: dict, paper_size: dict, results: Path) -> list[Path]:
         large = paper_size.get(model, {})
         if large.get("mean_f_gro") is not None:
             below = large["mean_f_gro"] <= 0
-            ax.plot([1e5 * 1.05 ** k], [large["v_col"]], "v" if below else "^", color=c,
-                    ms=9, label=f"{model}, 2 x 50000: <f_gro> {large['mean_f_gro']:+.2f} "
-                                f"at {large['v_col']:g} m/s")
+            ax.plot([2 * PAPER_SIZE["n"] * 1.05 ** k], [large["v_col"]], "v" if below else "^",
+                    color=c, ms=9, label=f"{model}, 2 x {PAPER_SIZE['n']}: <f_gro> "
+                                         f"{large['mean_f_gro']:+.2f} at {large['v_col']:g} m/s")
     ax.set_xscale("log")
     ax.set_xlabel("N_total (grains in both aggregates)")
     ax.set_ylabel("v_fra (m/s)")
