@@ -71,24 +71,39 @@ def compare(rows: list[dict], model: str, b2: float) -> dict:
 
 def main(argv=None) -> int:
     p = campaign_study_parser(__doc__)
+    p.add_argument("--models", nargs="+", default=None, metavar="MODEL",
+                   help="run only these models (default: both); the summary takes every "
+                        "finished run below RUNS")
     args = p.parse_args(argv)
     plan = QUICK if args.quick else FULL
+    unknown = sorted(set(args.models or []) - set(plan["models"]))
+    if unknown:
+        p.error(f"unknown model {unknown[0]!r}: give one of {plan['models']}")
     runs, results = study_paths(args, "damped_dt")
+    for model in args.models or plan["models"]:
+        run_campaigns({name: spec(plan, model, step) for name, step in STEPS.items()},
+                      model_home(runs, plan["n"], model), args.np)
     rows = []
     for model in plan["models"]:
-        home = model_home(runs, plan["n"], model)
-        run_campaigns({name: spec(plan, model, step) for name, step in STEPS.items()},
-                      home, args.np)
-        for name, where in campaign_paths(STEPS, home).items():
+        for name, where in campaign_paths(STEPS, model_home(runs, plan["n"], model)).items():
             rows += [dict(r, step=name) for r in outcome_rows(where, plan["n"], model)
                      if r["stop_reason"] in COMPLETE]
     write_csv(results / "runs.csv", rows)
+    # a model is compared once each step has two runs or more at each offset
+    done = [m for m in plan["models"] if all(
+        sum(r["model"] == m and r["step"] == name and abs(r["B_off"] ** 2 - b2) < 1e-9
+            for r in rows) >= 2 for name in STEPS for b2 in plan["b_off2"])]
     summary = dict(plan=plan, steps=STEPS, results={
         model: {f"{b2:.4f}": compare(rows, model, b2) for b2 in plan["b_off2"]}
-        for model in plan["models"]},
+        for model in done},
+        runs={model: {name: sum(r["model"] == model and r["step"] == name for r in rows)
+                      for name in STEPS} for model in done},
+        loop_minutes={model: {name: sum(r["loop_seconds"] for r in rows if r["model"] == model
+                                        and r["step"] == name) / 60 for name in STEPS}
+                      for model in done},
         dt_auto_over_tc=sorted({r["dt_over_tc"] for r in rows if r["step"] == "dt auto"}),
-        energy_error_max={name: max(r["energy_error"] for r in rows if r["step"] == name)
-                          for name in STEPS},
+        energy_error_max={name: max((r["energy_error"] for r in rows if r["step"] == name),
+                                    default=None) for name in STEPS},
         runs_finished=len(rows))
     (results / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
     print(json.dumps(summary["results"], indent=1))
