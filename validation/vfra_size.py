@@ -149,8 +149,8 @@ def outcome_rows(home: Path, n: int, model: str) -> list[dict]:
 def size_trend(rows: list[dict]) -> dict:
     """Per model: v_fra at each size with the range of its seeds' own v_fra (or, where the
     speeds run do not place it, the bound they give: above the fastest or below the
-    slowest), and the fit v_fra = a + b log10(N_total) over the sizes that place it, with
-    its value at the paper's N_total = 10^5 (None where fewer than two sizes place v_fra)."""
+    slowest), and the fit v_fra = a + b log10(N_total) over the largest sizes that all
+    place it, with its value at the paper's N_total = 10^5 (None where fewer than two do)."""
     out = {}
     for model in MODELS:
         mine = [r for r in rows if r["model"] == model]
@@ -166,12 +166,20 @@ def size_trend(rows: list[dict]) -> dict:
                                bound=None if found else (
                                    ("below", c["v_col"][0]) if c["mean_f_gro"][0] <= 0
                                    else ("above", c["v_col"][-1]))))
-        placed = [p for p in points if p["v_fra"] is not None]
+        # the fit takes the largest sizes that all place v_fra: a smaller size that places
+        # it again below one that does not (damped frictionless: 2 x 100 does, 2 x 250 and
+        # 2 x 1000 do not) would draw a line through a gap it cannot see
+        placed = []
+        for point in reversed(points):
+            if point["v_fra"] is None:
+                break
+            placed.insert(0, point)
         fit = None
         if len(placed) >= 2:
             b, a = np.polyfit(np.log10([p["n_total"] for p in placed]),
                               [p["v_fra"] for p in placed], 1)
-            fit = dict(a=float(a), b=float(b), at_1e5=float(a + 5 * b))
+            fit = dict(a=float(a), b=float(b), at_1e5=float(a + 5 * b),
+                       n_total=[p["n_total"] for p in placed])
         out[model] = dict(points=points, fit=fit, paper_v_fra=MODELS[model][2])
     return out
 
@@ -203,7 +211,7 @@ def figure(trend: dict, paper_size: dict, results: Path) -> list[Path]:
                         label=f"{model}: {side} the {'fastest' if side == 'above' else 'slowest'}"
                               " speed run")
         if t["fit"]:
-            x = np.logspace(np.log10(min(p["n_total"] for p in placed)), 5, 50)
+            x = np.logspace(np.log10(t["fit"]["n_total"][0]), 5, 50)
             ax.plot(x, t["fit"]["a"] + t["fit"]["b"] * np.log10(x), "--", color=c, lw=1)
         ax.plot([1e5], [t["paper_v_fra"]], "*", ms=12, color=c, mec="k", mew=0.5)
         large = paper_size.get(model, {})
