@@ -46,7 +46,7 @@ import numpy as np
 
 from bpca3d_models import FULL as SMALLER_PLAN, MODELS
 from common import HERE, campaign_study_parser, loop_seconds, run_campaigns, save, study_paths
-from jkrdt import rundir
+from jkrdt import campaign as campaign_module, rundir
 from jkrdt.analysis.summary import b_off_mean, threshold_velocity
 from jkrdt.analysis.tables import read_csv, write_csv
 from jkrdt.stopping import COMPLETE
@@ -368,17 +368,25 @@ def main(argv=None) -> int:
         for n in plan["sizes"]:
             for model in args.models or plan["grids"]:
                 run_model(model, n, plan, runs, args.np)
-    # every finished run below RUNS goes into the tables, whichever call ran it
-    rows, sizes = [], {}
+    # every finished run below RUNS goes into runs.csv, whichever call ran it; a model
+    # enters the summary, the trend and the figures once its seed 2 has run (before that
+    # its curve is phase 1's so far), and is listed as under way until then
+    rows, sizes, under_way = [], {}, {}
     for n in plan["sizes"]:
         for model in plan["grids"]:
-            mine = outcome_rows(model_home(runs, n, model), n, model)
-            if mine:
-                rows += mine
+            home = model_home(runs, n, model)
+            mine = outcome_rows(home, n, model)
+            second = home / f"seed{SEEDS[1]}"
+            done = (second / campaign_module.SPEC_RECORD).exists() and len(
+                outcome_rows(second, n, model)) == 2 * len(plan["b_off2"])
+            (rows if done else under_way.setdefault(str(n), {}).setdefault(model, [])
+             ).extend(mine)
+            if done:
                 sizes.setdefault(str(n), {})[model] = size_summary(mine, model)
     large = [r for model in PAPER_SIZE["speeds"] for r in
              outcome_rows(model_home(runs, PAPER_SIZE["n"], model), PAPER_SIZE["n"], model)]
-    write_csv(results / "runs.csv", rows + large)
+    write_csv(results / "runs.csv", rows + [r for m in under_way.values() for x in m.values()
+                                            for r in x] + large)
     # the size trend: the committed smaller sizes of bpca3d_models with these (not in the
     # quick variant, whose sizes are its own)
     before = [] if args.quick else [r for r in read_csv(SMALLER) if r["size"] not in
@@ -389,7 +397,9 @@ def main(argv=None) -> int:
     growth_figure(before + rows, paper_size, results)
     summary = dict(plan=plan, tolerance=TOLERANCE, ranks=args.np,
                    seconds_this_call=time.time() - t0, load=os.getloadavg()[0], sizes=sizes,
-                   trend=trend, paper_size=paper_size)
+                   trend=trend, paper_size=paper_size,
+                   under_way={n: {m: len(x) for m, x in by.items() if x}
+                              for n, by in under_way.items()})
     (results / "summary.json").write_text(json.dumps(summary, indent=2, default=float) + "\n")
     print(json.dumps(dict(sizes=sizes, paper_size=paper_size), indent=1, default=float))
     return 0
