@@ -11,7 +11,8 @@ brackets each model's v_fra as the smaller sizes place it (GRIDS), at B_off^2 = 
             every speed (v_fra has moved out of the grid with N), seed 1 at the paper's
             next speed beyond the grid on that side, one speed at a time (at most EXTEND,
             within 10-125.9 m/s);
-  phase 2   seed 2 at the two speeds on either side of seed 1's v_fra.
+  phase 2   seed 2 at the two speeds on either side of seed 1's v_fra, then at the speeds
+            on either side of both seeds' v_fra where it has not run yet.
 
 Each model's phases are campaigns of their own (``RUNS/n<N>/<model>/seed<k>``, an
 extension ``seed1_v<speed>``), run one after the other, damped models first (their gap to
@@ -64,8 +65,8 @@ GRIDS = {"frictionless, T_vis 6 ps": [50.1, 63.1, 79.4, 100.0, 125.9],
 EXTEND = 3
 QUICK = dict(sizes=[24], grids={"frictional": [10.0, 39.8, 100.0],
                                 "frictionless": [10.0, 39.8, 100.0]}, b_off2=[0.0, 0.5],
-             extend=0)
-FULL = dict(sizes=[5000], grids=GRIDS, b_off2=SMALLER_PLAN["b_off2"], extend=EXTEND)
+             extend=0, follow=0)
+FULL = dict(sizes=[5000], grids=GRIDS, b_off2=SMALLER_PLAN["b_off2"], extend=EXTEND, follow=2)
 #: the 3D paper's size (issue 23, item 2): both damped models at 63.1 m/s, where the paper
 #: has them fragmenting and 2 x 1000 grains still grow, and the undamped frictionless model
 #: at 39.8 m/s (the paper's Fig. 1); seed 1, B_off^2 0 and 6/12 of every model first
@@ -282,7 +283,7 @@ def model_home(runs: Path, n: int, model: str) -> Path:
 
 
 def run_model(model: str, n: int, plan: dict, runs: Path, ranks: int) -> None:
-    """Phase 1, its extension and phase 2 of one model at 2 x ``n`` grains."""
+    """Phase 1, its extension and phase 2 (with its follow-up) of one model at 2 x ``n``."""
     grid = plan["grids"][model]
     home = model_home(runs, n, model)
     first = f"seed{SEEDS[0]}"
@@ -295,8 +296,26 @@ def run_model(model: str, n: int, plan: dict, runs: Path, ranks: int) -> None:
         name = f"{first}_v{speed:g}"
         run_campaigns({name: spec(model, n, [speed], plan["b_off2"], SEEDS[0])}, home, ranks)
         rows += outcome_rows(home / name, n, model)
-    run_campaigns({f"seed{SEEDS[1]}": spec(model, n, nearest_two(curve(rows)),
-                                           plan["b_off2"], SEEDS[1])}, home, ranks)
+    second = f"seed{SEEDS[1]}"
+    run_campaigns({second: spec(model, n, nearest_two(curve(rows)), plan["b_off2"],
+                                SEEDS[1])}, home, ranks)
+    # seed 2 may move v_fra out of seed 1's bracket: seed 2 then runs at the new bracket's
+    # speeds too, so that both seeds stand at the two speeds nearest v_fra
+    for _ in range(plan["follow"]):
+        rows = outcome_rows(home, n, model)
+        missing = seed_2_missing(rows, len(plan["b_off2"]))
+        if not missing:
+            break
+        for speed in missing:
+            run_campaigns({f"{second}_v{speed:g}": spec(model, n, [speed], plan["b_off2"],
+                                                         SEEDS[1])}, home, ranks)
+
+
+def seed_2_missing(rows: list[dict], offsets: int) -> list[float]:
+    """The speeds nearest v_fra of the seeds' curve in ``rows`` at which seed 2 has not run
+    at every offset."""
+    return [v for v in nearest_two(curve(rows))
+            if sum(r["seed"] == SEEDS[1] and r["v_col"] == v for r in rows) < offsets]
 
 
 def run_paper_size(runs: Path, ranks: int, b_off2: list[float]) -> None:
@@ -376,9 +395,8 @@ def main(argv=None) -> int:
         for model in plan["grids"]:
             home = model_home(runs, n, model)
             mine = outcome_rows(home, n, model)
-            second = home / f"seed{SEEDS[1]}"
-            done = (second / campaign_module.SPEC_RECORD).exists() and len(
-                outcome_rows(second, n, model)) == 2 * len(plan["b_off2"])
+            done = (home / f"seed{SEEDS[1]}" / campaign_module.SPEC_RECORD).exists() and \
+                not (plan["follow"] and seed_2_missing(mine, len(plan["b_off2"])))
             (rows if done else under_way.setdefault(str(n), {}).setdefault(model, [])
              ).extend(mine)
             if done:
