@@ -253,7 +253,7 @@ def growth_figure(rows: list[dict], paper_size: dict, results: Path) -> list[Pat
             if not at:
                 continue
             c = curve(at)
-            label = f"2 x {n}: " + (f"v_fra {c['v_fra']:.3g} m/s" if c["v_fra"] else "no v_fra")
+            label = f"2 x {int(n)}: " + (f"v_fra {c['v_fra']:.3g} m/s" if c["v_fra"] else "no v_fra")
             ax.semilogx(c["v_col"], c["mean_f_gro"], "o-", ms=3, color=shade[n],
                         lw=1 + sizes.index(n) * 0.6, label=label)
         large = paper_size.get(model, {})
