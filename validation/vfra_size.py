@@ -14,8 +14,8 @@ brackets each model's v_fra as the smaller sizes place it (GRIDS), at B_off^2 = 
   phase 2   seed 2 at the two speeds on either side of seed 1's v_fra, then at the speeds
             on either side of both seeds' v_fra where it has not run yet.
 
-Each model's phases are campaigns of their own (``RUNS/n<N>/<model>/seed<k>``, an
-extension ``seed1_v<speed>``), run one after the other, damped models first (their gap to
+Each model's phases are campaigns of their own (``RUNS/n<N>/<model>/seed<k>``, an added
+speed ``seed<k>_v<speed>``), run one after the other, damped models first (their gap to
 the paper is the open question), and a second call resumes them. ``--paper-size`` runs
 instead the 12 collisions at the paper's 2 x 50000 grains (PAPER_SIZE), one campaign per
 model and offset. Every run ends by the settle rule, its dt chosen by ``--dt auto`` for
@@ -188,8 +188,9 @@ def size_trend(rows: list[dict]) -> dict:
 def figure(trend: dict, paper_size: dict, results: Path) -> list[Path]:
     """fig_vfra_size: v_fra against N_total per model, the seeds' range as error bars,
     sizes whose speeds place no v_fra as open triangles at the bound they give (up: above
-    the fastest speed, down: below the slowest), the fits to 10^5 and the paper's values; at 10^5, where all four offsets of PAPER_SIZE ran, a
-    bound: v_fra below its speed (<f_gro> <= 0 there, a triangle down) or above it (up)."""
+    the fastest speed, down: below the slowest), the fits to 10^5 and the paper's values;
+    at 10^5, where all four offsets of PAPER_SIZE ran, a bound: v_fra below its speed
+    (<f_gro> <= 0 there, a triangle down) or above it (up)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -253,7 +254,8 @@ def growth_figure(rows: list[dict], paper_size: dict, results: Path) -> list[Pat
             if not at:
                 continue
             c = curve(at)
-            label = f"2 x {int(n)}: " + (f"v_fra {c['v_fra']:.3g} m/s" if c["v_fra"] else "no v_fra")
+            label = f"2 x {int(n)}: " + (f"v_fra {c['v_fra']:.3g} m/s" if c["v_fra"]
+                                          else "no v_fra")
             ax.semilogx(c["v_col"], c["mean_f_gro"], "o-", ms=3, color=shade[n],
                         lw=1 + sizes.index(n) * 0.6, label=label)
         large = paper_size.get(model, {})
