@@ -7,7 +7,7 @@ dt = 0.014 t_c. The trade study (benchmarks/tradeoff) showed the outcomes unchan
 of its own, and --dt auto takes about twice 0.014 t_c at 63.1 m/s. Before the damped
 models' v_fra at 2 x 5000 is read against 2 x 1000 this study asks whether dt alone moves
 it: both damped models at 2 x 1000 grains, 63.1 m/s, the two offsets whose f_gro decides
-<f_gro> there (B_off^2 = 3/12, 6/12), SEEDS seeds, once at dt = 0.014 t_c and once at
+<f_gro> there (B_off^2 = 3/12, 6/12), 6 seeds (FULL), once at dt = 0.014 t_c and once at
 --dt auto (1e-3). Collisions are chaotic, so the two are compared as ensembles: per model
 and offset, the means of f_gro and N_lar / N with their standard errors, and the
 difference against twice its standard error.
