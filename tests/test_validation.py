@@ -148,7 +148,7 @@ def test_the_paper_size_study_runs_end_to_end_in_small(tmp_path):
     # f_gro near 1 well below v_fra), the energy error keeps the tolerance dt was chosen for,
     # and the stages and the record are measured. The run takes 40 s on a quiet machine;
     # its limit is 10 minutes: with a campaign at nice 10 holding both cores it once ran
-    # past 5, as its two ranks wait on each other at every step
+    # past 5
     subprocess.run([sys.executable, str(ROOT / "validation" / "paper_size.py"), "--n", "300",
                     "--only", "sticking", "--limit-minutes", "10", "--runs",
                     str(tmp_path / "runs"), "--results", str(tmp_path / "results")],
@@ -237,6 +237,30 @@ def test_a_grid_that_misses_v_fra_is_extended_along_the_papers_speeds():
     assert next_speed(curve(rows({39.8: 0.2, 50.1: -0.01, 63.1: -0.1}))) is None
     assert next_speed(curve(rows({10.0: -0.2, 12.6: -0.3}))) is None
     assert next_speed(curve(rows({100.0: 0.2, 125.9: 0.1}))) is None
+
+
+def test_seed_2_follows_v_fra_where_it_moves():
+    # 2 x 5000, damped frictionless: seed 1 fell to <= 0 between 39.8 and 50.1 m/s, seed 2
+    # ran there and grew at 50.1, so both seeds' curve crosses 0 between 50.1 and 63.1:
+    # seed 2 must run at 63.1 too (at every offset), and nowhere else
+    sys.path.insert(0, str(ROOT / "validation"))
+    try:
+        from vfra_size import seed_2_missing
+    finally:
+        sys.path.pop(0)
+
+    def run(v, seed, f, b2=0.0):
+        return dict(v_col=v, B_off=b2 ** 0.5, seed=seed, growth_efficiency=f,
+                    stop_reason="settled")
+
+    rows = [run(39.8, 1, 0.1), run(50.1, 1, -0.01), run(63.1, 1, -0.1),
+            run(39.8, 2, 0.1), run(50.1, 2, 0.2)]
+    assert seed_2_missing(rows, offsets=1) == [63.1]
+    assert seed_2_missing(rows + [run(63.1, 2, -0.2)], offsets=1) == []
+    # with two offsets, seed 2 at 63.1 at one of them is not yet there
+    both = [run(r["v_col"], r["seed"], r["growth_efficiency"], b2) for r in rows
+            for b2 in (0.0, 0.5)]
+    assert seed_2_missing(both + [run(63.1, 2, -0.2)], offsets=2) == [63.1]
 
 
 def test_the_size_trend_places_v_fra_as_the_smaller_study_did():
