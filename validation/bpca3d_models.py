@@ -54,6 +54,8 @@ QUICK = dict(sizes=[24], seeds=[1], b_off2=[0.0, 0.5], v_col=[10.0, 39.8, 100.0]
 #: the seeds of --large-seeds: a 2 x 1000 run costs 40 s to 5 min on one core
 LARGE, LARGE_V_COL = 1000, [15.8, 20.0, 25.1, 39.8, 63.1, 100.0]
 SMALL = (1, 4, 16)          # N of the N_cum(<= N) columns
+#: the step of every run of this study (t_c)
+DT = 0.014
 
 
 def grid(n: int, plan: dict) -> dict:
@@ -63,10 +65,16 @@ def grid(n: int, plan: dict) -> dict:
                 seeds=plan["large_seeds"] if large else plan["seeds"])
 
 
-def spec(model: str, n: int, plan: dict) -> dict:
+def model_spec(model: str, n: int, **rest) -> dict:
+    """The campaign spec of one of the paper's four models for two ice BPCAs of ``n``
+    grains; ``rest``: the speeds, offsets, seeds and the step."""
     kind, tvis, _ = MODELS[model]
     return dict(kind="bpca", dim=3, n_tar=n, n_pro=n, material="ice",
-                material_overrides=dict(tvis=tvis), model=kind, **grid(n, plan), dt=0.014)
+                material_overrides=dict(tvis=tvis), model=kind, **rest)
+
+
+def spec(model: str, n: int, plan: dict) -> dict:
+    return model_spec(model, n, **grid(n, plan), dt=DT)
 
 
 def model_curve(where: Path, n_total: int) -> dict:

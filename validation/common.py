@@ -11,6 +11,8 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
+
 BIN = Path(sys.executable).parent
 HERE = Path(__file__).resolve().parent
 
@@ -82,3 +84,17 @@ def save(fig, results: Path, stem: str) -> list[Path]:
         out.append(results / f"{stem}{suffix}")
     plt.close(fig)
     return out
+
+
+def mean_se(values) -> tuple[float, float]:
+    """An ensemble's mean and the standard error of that mean (NaN for one value)."""
+    x = np.asarray(values, dtype=float)
+    return float(x.mean()), float(x.std(ddof=1) / np.sqrt(len(x))) if len(x) > 1 else float("nan")
+
+
+def within_scatter(a: tuple[float, float], b: tuple[float, float]) -> tuple[float, float, bool]:
+    """Two ensembles' (mean, standard error): the difference b - a, its standard error, and
+    whether they agree (|difference| within two of its standard errors). Collisions are
+    chaotic, so outcomes are compared this way, never run against run."""
+    se = float(np.hypot(a[1], b[1]))
+    return b[0] - a[0], se, bool(abs(b[0] - a[0]) <= 2 * se + 1e-12)

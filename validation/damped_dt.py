@@ -23,49 +23,37 @@ from __future__ import annotations
 import json
 import sys
 
-import numpy as np
-
-from bpca3d_models import MODELS
-from common import campaign_paths, campaign_study_parser, run_campaigns, study_paths
+from bpca3d_models import DT, model_spec
+from common import (campaign_paths, campaign_study_parser, mean_se, run_campaigns,
+                    study_paths, within_scatter)
 from jkrdt.analysis.tables import write_csv
 from jkrdt.stopping import COMPLETE
 from vfra_size import TOLERANCE, model_home, outcome_rows
 
-#: the step of bpca3d_models' runs
-DT_FIXED = 0.014
 FULL = dict(n=1000, v_col=63.1, b_off2=[0.25, 0.5], seeds=[1, 2, 3, 4, 5, 6],
             models=["frictionless, T_vis 6 ps", "frictional, T_vis 6 ps"])
 QUICK = dict(n=24, v_col=63.1, b_off2=[0.25], seeds=[1, 2, 3],
              models=["frictionless, T_vis 6 ps"])
-STEPS = {"dt 0.014": dict(dt=DT_FIXED), "dt auto": dict(dt="auto", tolerance=TOLERANCE)}
+STEPS = {"dt 0.014": dict(dt=DT), "dt auto": dict(dt="auto", tolerance=TOLERANCE)}
 
 
 def spec(plan: dict, model: str, step: dict) -> dict:
-    kind, tvis, _ = MODELS[model]
-    return dict(kind="bpca", dim=3, n_tar=plan["n"], n_pro=plan["n"], material="ice",
-                material_overrides=dict(tvis=tvis), model=kind, v_col=[plan["v_col"]],
-                b_off2=plan["b_off2"], seeds=plan["seeds"], **step)
-
-
-def mean_se(values: list[float]) -> tuple[float, float]:
-    """The mean and its standard error (0 for one value)."""
-    a = np.asarray(values, dtype=float)
-    return float(a.mean()), float(a.std(ddof=1) / np.sqrt(len(a))) if len(a) > 1 else 0.0
+    return model_spec(model, plan["n"], v_col=[plan["v_col"]], b_off2=plan["b_off2"],
+                      seeds=plan["seeds"], **step)
 
 
 def compare(rows: list[dict], model: str, b2: float) -> dict:
-    """f_gro and N_lar / N of one model and offset at both steps, and whether they agree:
-    |difference| below twice its standard error."""
+    """f_gro and N_lar / N of one model and offset at both steps, and whether they agree
+    (``common.within_scatter``)."""
     out = {}
     for measure, value in (("f_gro", lambda r: r["growth_efficiency"]),
                            ("N_lar_over_N", lambda r: r["n_largest"] / r["n_total"])):
         at = {name: mean_se([value(r) for r in rows if r["model"] == model
                              and r["step"] == name and abs(r["B_off"] ** 2 - b2) < 1e-9])
               for name in STEPS}
-        (a, sa), (b, sb) = at["dt 0.014"], at["dt auto"]
-        se = float(np.hypot(sa, sb))
-        out[measure] = dict(at_0014=[a, sa], at_auto=[b, sb], difference=b - a,
-                            se=se, agree=bool(abs(b - a) <= 2 * se))
+        difference, se, agree = within_scatter(at["dt 0.014"], at["dt auto"])
+        out[measure] = dict(at_0014=list(at["dt 0.014"]), at_auto=list(at["dt auto"]),
+                            difference=difference, se=se, agree=agree)
     return out
 
 

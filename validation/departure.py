@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from common import campaign_paths, loop_seconds, run_campaigns
+from common import campaign_paths, loop_seconds, mean_se, run_campaigns, within_scatter
 from jkrdt.analysis import dumps, fragments
 from jkrdt.analysis.tables import read_csv, write_csv
 from jkrdt import rundir
@@ -104,14 +104,9 @@ def compare(rows: list[dict]) -> dict:
                 continue
             entry = dict(runs={d: len(pick[d]) for d in VARIANTS})
             for m in MEASURES:
-                stats = {}
-                for d in VARIANTS:
-                    x = np.array([r[m] for r in pick[d]])
-                    se = float(x.std(ddof=1) / np.sqrt(len(x))) if len(x) > 1 else float("nan")
-                    stats[d] = dict(mean=float(x.mean()), se=se)
-                diff = abs(stats["yes"]["mean"] - stats["shadow"]["mean"])
-                combined = float(np.hypot(stats["yes"]["se"], stats["shadow"]["se"]))
-                stats["agree"] = bool(diff <= 2 * combined + 1e-12)
+                at = {d: mean_se([r[m] for r in pick[d]]) for d in VARIANTS}
+                stats = {d: dict(mean=mean, se=se) for d, (mean, se) in at.items()}
+                stats["agree"] = within_scatter(at["yes"], at["shadow"])[2]
                 entry[m] = stats
             entry["loop_seconds"] = {d: float(np.mean([r["loop_seconds"] for r in pick[d]]))
                                      for d in VARIANTS}

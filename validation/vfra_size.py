@@ -45,7 +45,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bpca3d_models import FULL as SMALLER_PLAN, MODELS
+from bpca3d_models import FULL as SMALLER_PLAN, MODELS, model_spec
 from common import HERE, campaign_study_parser, loop_seconds, run_campaigns, save, study_paths
 from jkrdt import campaign as campaign_module, rundir
 from jkrdt.analysis.summary import b_off_mean, threshold_velocity
@@ -81,10 +81,8 @@ SMALLER = HERE / "bpca3d_models" / "runs.csv"
 
 
 def spec(model: str, n: int, speeds: list[float], b_off2: list[float], seed: int) -> dict:
-    kind, tvis, _ = MODELS[model]
-    return dict(kind="bpca", dim=3, n_tar=n, n_pro=n, material="ice",
-                material_overrides=dict(tvis=tvis), model=kind, v_col=speeds, b_off2=b_off2,
-                seeds=[seed], dt="auto", tolerance=TOLERANCE)
+    return model_spec(model, n, v_col=speeds, b_off2=b_off2, seeds=[seed], dt="auto",
+                      tolerance=TOLERANCE)
 
 
 def nearest_two(c: dict) -> list[float]:
@@ -399,10 +397,11 @@ def main(argv=None) -> int:
             mine = outcome_rows(home, n, model)
             done = (home / f"seed{SEEDS[1]}" / campaign_module.SPEC_RECORD).exists() and \
                 not (plan["follow"] and seed_2_missing(mine, len(plan["b_off2"])))
-            (rows if done else under_way.setdefault(str(n), {}).setdefault(model, [])
-             ).extend(mine)
             if done:
+                rows += mine
                 sizes.setdefault(str(n), {})[model] = size_summary(mine, model)
+            elif mine:
+                under_way.setdefault(str(n), {})[model] = mine
     large = [r for model in PAPER_SIZE["speeds"] for r in
              outcome_rows(model_home(runs, PAPER_SIZE["n"], model), PAPER_SIZE["n"], model)]
     write_csv(results / "runs.csv", rows + [r for m in under_way.values() for x in m.values()
@@ -418,7 +417,7 @@ def main(argv=None) -> int:
     summary = dict(plan=plan, tolerance=TOLERANCE, ranks=args.np,
                    seconds_this_call=time.time() - t0, load=os.getloadavg()[0], sizes=sizes,
                    trend=trend, paper_size=paper_size,
-                   under_way={n: {m: len(x) for m, x in by.items() if x}
+                   under_way={n: {m: len(x) for m, x in by.items()}
                               for n, by in under_way.items()})
     (results / "summary.json").write_text(json.dumps(summary, indent=2, default=float) + "\n")
     print(json.dumps(dict(sizes=sizes, paper_size=paper_size), indent=1, default=float))
