@@ -240,14 +240,49 @@ inline double breaking_loss(double delta, double vn, double dt, const NormalScal
 }
 
 /* ----------------------------------------------------------------------
+   a step that clamps or breaks books, per channel, what the loads' work over
+   the step and the change of the channel's potential leave over
+   (step_dissipation). after: the state the step leaves and its
+   displacements, null when the contact breaks. Rare: kept out of the common
+   step's registers.
+------------------------------------------------------------------------- */
+
+[[gnu::noinline, gnu::cold]] inline void book_tangential_step(
+    const ContactConstants &c, const ContactMotion &m, double dt, const ContactState &before,
+    const ContactState &now, const Displacements *after, ContactResult &out)
+{
+  const Tangential &K = c.K;
+  const double R = c.S.R;
+  const V3 nc = m.rinv * m.d12;    // eq. (9)
+  ChannelLoad load[NCHANNEL], prev[NCHANNEL];
+  if (!after)
+    for (int ch = 0; ch < NCHANNEL; ch++) load[ch] = {0.0, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+  else
+    tangential_load(now, *after, nc, m.rinv, c.r1, c.r2, R, K, load);  // eqs. (14)-(27)
+  const V3 dx12 = dt * m.v12;
+  const V3 dtheta1 = dt * m.w1, dtheta2 = dt * m.w2;
+  const V3 d12_before = m.d12 - dx12;
+  const double rinv_before = 1.0 / norm(d12_before);
+  tangential_load(before, rinv_before * d12_before, rinv_before, c.r1, c.r2, R, K, prev);
+  for (int ch = 0; ch < NCHANNEL; ch++) {
+    const double w_before = channel_work(prev[ch], dx12, dtheta1, dtheta2);
+    const double w_after = channel_work(load[ch], dx12, dtheta1, dtheta2);
+    out.loss[LOSS_SLIDING + ch] += step_dissipation(prev[ch].U, w_before, load[ch].U, w_after);
+  }
+  out.lossy = true;
+}
+
+/* ----------------------------------------------------------------------
    the tangential channels over one step (section 2.2); adds their loads
    to the result, books clamps and, for a contact that breaks, the springs'
    energy
 ------------------------------------------------------------------------- */
 
-inline void tangential_step(const ContactConstants &c, const StateLayout &L,
-                            const ContactMotion &m, double dt, bool setup, bool formed,
-                            bool breaking, bool energy, double *state, ContactResult &out)
+[[gnu::always_inline]] inline void tangential_step(const ContactConstants &c,
+                                                   const StateLayout &L, const ContactMotion &m,
+                                                   double dt, bool setup, bool formed,
+                                                   bool breaking, bool energy, double *state,
+                                                   ContactResult &out)
 {
   const Tangential &K = c.K;
   const double R = c.S.R;
@@ -281,27 +316,8 @@ inline void tangential_step(const ContactConstants &c, const StateLayout &L,
     else
       clamped = clamp_to_elastic_limits(now, nc, c.r1, c.r2, R, K, d);
   }
-  const bool booked = traced && !setup && (breaking || clamped);
-  if (booked) {
-    // a step that clamps or breaks books, per channel, what the loads' work over the step
-    // and the change of the channel's potential leave over (step_dissipation)
-    ChannelLoad load[NCHANNEL], prev[NCHANNEL];
-    if (breaking)
-      for (int ch = 0; ch < NCHANNEL; ch++) load[ch] = {0.0, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
-    else
-      tangential_load(now, d, nc, m.rinv, c.r1, c.r2, R, K, load);       // eqs. (14)-(27)
-    const V3 dx12 = dt * m.v12;
-    const V3 dtheta1 = dt * m.w1, dtheta2 = dt * m.w2;
-    const V3 d12_before = m.d12 - dx12;
-    const double rinv_before = 1.0 / norm(d12_before);
-    tangential_load(before, rinv_before * d12_before, rinv_before, c.r1, c.r2, R, K, prev);
-    for (int ch = 0; ch < NCHANNEL; ch++) {
-      const double w_before = channel_work(prev[ch], dx12, dtheta1, dtheta2);
-      const double w_after = channel_work(load[ch], dx12, dtheta1, dtheta2);
-      out.loss[LOSS_SLIDING + ch] += step_dissipation(prev[ch].U, w_before, load[ch].U, w_after);
-    }
-    out.lossy = true;
-  }
+  if (traced && !setup && (breaking || clamped))
+    book_tangential_step(c, m, dt, before, now, breaking ? nullptr : &d, out);
   if (breaking) return;
   // the loads as every step computes them, so that a set-up reproduces the step's loads
   // bit for bit
@@ -327,9 +343,10 @@ struct NormalResult {
   bool broken;          // the contact separated in this step
 };
 
-inline void normal_step(const ContactConstants &c, const StateLayout &L, double vn, double delta,
-                        double dt, bool setup, bool formed, bool energy, double *state,
-                        NormalResult &n)
+[[gnu::always_inline]] inline void normal_step(const ContactConstants &c,
+                                               const StateLayout &L, double vn, double delta,
+                                               double dt, bool setup, bool formed,
+                                               bool energy, double *state, NormalResult &n)
 {
   const NormalScales &S = c.S;
   n.f = n.U_n = n.loss_event = n.loss_damping = 0.0;
@@ -341,7 +358,7 @@ inline void normal_step(const ContactConstants &c, const StateLayout &L, double 
     if (!setup) {
       n.lossy = true;
       n.loss_event = breaking_loss(delta, vn, dt, S);
-      if (c.damp > 0.0) n.loss_damping = 0.5 * dt * state[L.fd] * vn;
+      if (c.damp > 0.0 && L.fd >= 0) n.loss_damping = 0.5 * dt * state[L.fd] * vn;
     }
     return;
   }
@@ -351,7 +368,7 @@ inline void normal_step(const ContactConstants &c, const StateLayout &L, double 
   // contact formation (section 2.1): U_n jumps from 0 to U_n(0)
   if (formed && !setup) n.loss_event = event_loss(0.0, n.U_n, n.f, vn, dt);
 
-  if (c.damp > 0.0) {
+  if (c.damp > 0.0 && L.fd >= 0) {    // a damped contact stores F_D (state_fields)
     // eq. (A.5); a run's first evaluation reuses the stored F_D, so that a
     // continued run equals an uninterrupted one. Its work over the step is the
     // trapezoid F_D(n) (v_n(n-1/2) + v_n(n+1/2)) dt / 2 of the two half-kicks
@@ -370,9 +387,11 @@ inline void normal_step(const ContactConstants &c, const StateLayout &L, double 
    The state (L.dnum values) is read and written in place.
 ------------------------------------------------------------------------- */
 
-inline void contact_step(const ContactConstants &c, const StateLayout &L,
-                         const ContactMotion &m, double delta, double dt, bool setup,
-                         bool formed, bool energy, double *state, ContactResult &out)
+[[gnu::always_inline]] inline void contact_step(const ContactConstants &c,
+                                                const StateLayout &L, const ContactMotion &m,
+                                                double delta, double dt, bool setup,
+                                                bool formed, bool energy, double *state,
+                                                ContactResult &out)
 {
   out.M1 = out.M2 = {0.0, 0.0, 0.0};
   for (int ch = 0; ch < NCHANNEL; ch++) out.U[ch] = 0.0;

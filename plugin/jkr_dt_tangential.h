@@ -309,8 +309,9 @@ inline V3 corrected_pointer(const V3 &n, const V3 &shift)
 
 // bring the displacements back to their elastic limits; returns a bit per
 // channel that was clamped, and the displacements of the state it leaves in d
-inline int clamp_to_elastic_limits(ContactState &c, const V3 &nc, double r1, double r2, double R,
-                                   const Tangential &K, Displacements &d)
+[[gnu::always_inline]] inline int clamp_to_elastic_limits(ContactState &c, const V3 &nc,
+                                                          double r1, double r2, double R,
+                                                          const Tangential &K, Displacements &d)
 {
   int clamped = 0;
   if (K.sliding) {

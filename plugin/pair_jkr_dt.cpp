@@ -32,8 +32,9 @@ const char *const PairJKRDT::DEPARTED_GROUP = "jkrdt_departed";
 /* ---------------------------------------------------------------------- */
 
 PairJKRDT::PairJKRDT(LAMMPS *lmp) :
-    Pair(lmp), fix_contacts(nullptr), departed_bit(0), bins_bounded(true), bin_size_set(0.0),
-    bin_size_logged(0.0), bin_size_run(0.0), bins_stale(false), threads_logged(0), nstride(0),
+    Pair(lmp), fix_contacts(nullptr), departed_bit(0), bins_bounded(true), kernel_auto(true),
+    kernel_avx2(false), bin_size_set(0.0), bin_size_logged(0.0), bin_size_run(0.0),
+    bins_stale(false), threads_logged(0), nstride(0),
     dt_check(DT_CHECK_ERROR), tc_min(0.0), tc_types{0, 0}, tc_logged(0.0), dt_logged(0.0),
     dt_warned(0.0), checked_laststep(-1), step_max(0.0),
     step_warned(false), contacts_at_run_end(0), data_contacts(0)

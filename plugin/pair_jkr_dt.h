@@ -18,6 +18,14 @@
 
 #include "pair.h"
 
+// the AVX2 pair loop: GCC and Clang on x86-64 (three-operand SSE/AVX instructions, no fused
+// multiply-add, so the same bits as the portable loop)
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define JKRDT_AVX2 1
+#else
+#define JKRDT_AVX2 0
+#endif
+
 #include "fix_jkr_dt_contacts.h"
 #include "jkr_dt_contact.h"
 
@@ -200,9 +208,24 @@ class PairJKRDT : public Pair {
     bigint contact_ends;            // bonded contacts counted once per owned atom
     Trouble trouble;                // the first problem met; the thread stops there
   };
+  // the pair loop, written once and compiled twice: for any x86-64 (SSE2) and for CPUs
+  // with AVX2, chosen when the run starts (pair_style ... kernel auto|portable)
   template <bool TANGENTIAL>
-  void pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, ConstantsBy by,
-                 Accumulator &acc);
+  [[gnu::always_inline]] inline void pair_loop(int ii_from, int ii_to, int eflag,
+                                               bool tally_atoms, ConstantsBy by,
+                                               Accumulator &acc);
+  template <bool TANGENTIAL>
+  void pair_loop_portable(int ii_from, int ii_to, int eflag, bool tally_atoms, ConstantsBy by,
+                          Accumulator &acc);
+#if JKRDT_AVX2
+  template <bool TANGENTIAL>
+  __attribute__((target("avx2"), flatten)) void pair_loop_avx2(int ii_from, int ii_to,
+                                                               int eflag, bool tally_atoms,
+                                                               ConstantsBy by, Accumulator &acc);
+#endif
+  bool kernel_auto;    // pair_style ... kernel auto (default) or portable
+  bool kernel_avx2;    // this run's loop is the AVX2 one
+  bool kernel_logged = false;
   [[noreturn]] void report(const Trouble &t) const;
   int nthreads_used() const;
   std::vector<int> thread_of;         // owning thread of each owned atom (threaded runs) ...

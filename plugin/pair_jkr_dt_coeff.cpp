@@ -126,9 +126,10 @@ PairJKRDT::Input nothing_given()
 
 void PairJKRDT::settings(int narg, char **arg)
 {
-  // pair_style jkr/dt [dt_check error|warn|off] [bins bounded|box]
+  // pair_style jkr/dt [dt_check error|warn|off] [bins bounded|box] [kernel auto|portable]
   dt_check = DT_CHECK_ERROR;
   bins_bounded = true;
+  kernel_auto = true;
   data_contacts = 0;    // the deliberate fresh start from a marked data file
   if (fix_contacts && !modify->get_fix_by_id(FIX_ID)) {    // given anew after an unfix
     fix_contacts = nullptr;
@@ -149,10 +150,16 @@ void PairJKRDT::settings(int narg, char **arg)
       else if (value == "box") bins_bounded = false;
       else
         error->all(FLERR, "pair_style jkr/dt: bins takes bounded or box (got '{}')", value);
+    } else if (key == "kernel") {
+      if (value == "auto") kernel_auto = true;
+      else if (value == "portable") kernel_auto = false;
+      else
+        error->all(FLERR, "pair_style jkr/dt: kernel takes auto or portable (got '{}')", value);
     } else {
       error->all(FLERR,
                  "pair_style jkr/dt: unknown setting '{}'; the settings are 'dt_check "
-                 "error|warn|off' and 'bins bounded|box' (material parameters go in pair_coeff)",
+                 "error|warn|off', 'bins bounded|box' and 'kernel auto|portable' (material "
+                 "parameters go in pair_coeff)",
                  key);
     }
   }

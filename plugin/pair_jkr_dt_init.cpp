@@ -104,11 +104,18 @@ void PairJKRDT::init_style()
   neighbor->add_request(this, NeighConst::REQ_NEWTON_OFF);
   start_bins(cutmax + neighbor->skin);
 
+  // the AVX2 loop where this CPU has AVX2 (kernel auto): the same bits, fewer instructions
+#if JKRDT_AVX2
+  kernel_avx2 = kernel_auto && __builtin_cpu_supports("avx2");
+#else
+  kernel_avx2 = false;
+#endif
   const int nthreads = nthreads_used();
-  if (comm->me == 0 && nthreads != threads_logged)
-    utils::logmesg(lmp, "pair jkr/dt: {} OpenMP thread{} per rank\n", nthreads,
-                   nthreads > 1 ? "s" : "");
+  if (comm->me == 0 && (nthreads != threads_logged || kernel_avx2 != kernel_logged))
+    utils::logmesg(lmp, "pair jkr/dt: {} OpenMP thread{} per rank, {} pair loop\n", nthreads,
+                   nthreads > 1 ? "s" : "", kernel_avx2 ? "AVX2" : "portable");
   threads_logged = nthreads;
+  kernel_logged = kernel_avx2;
 #if !defined(_OPENMP)
   if (comm->me == 0 && comm->nthreads > 1)
     error->warning(FLERR, "pair jkr/dt was built without OpenMP: it runs on 1 thread of the {} "
