@@ -2,7 +2,7 @@
 Writes JSON; asserts nothing.
 
     python benchmarks/bench_pair.py [--sizes 2500 25000] [--configs serial mpi2 omp2]
-                                    [--baseline OLD_PLUGIN.so] [--quick]
+                                    [--baseline OLD_PLUGIN.so] [--portable] [--quick]
 
 Scenes: two equal BPCA ice aggregates of each size, 20 m/s, B_off 0.3, written by
 `jkrdt setup` (cached in --scenes, since 2 x 25000 grains take ~2 min to build).
@@ -12,6 +12,8 @@ Styles, each on the same data file, dt = 0.014 t_c:
   granular full                   jkr + mindlin + sds + marshall
   granular jkr                    jkr, no tangential history
   (baseline) full / frictionless  the same two with --baseline, an older build of the plugin
+  (portable) full / frictionless  the same two with --portable, on the SSE2 pair loop
+                                  (pair_style jkr/dt kernel portable) where the CPU has AVX2
 Parallel set-ups: serial (1 rank), mpi2 (mpirun -np 2), omp2 (1 rank, 2 OpenMP threads
 through '-sf omp -pk omp 2', as a LAMMPS user asks for them); skin20 (1 rank, a 20 nm
 neighbor skin instead of 10 nm: twice the neighbors that are not in contact).
@@ -71,6 +73,9 @@ STYLES = {
     "granular jkr": "pair_style granular\n" + GRANULAR_JKR + "tangential linear_nohistory 0.0 0.0",
 }
 BASELINE = {"baseline full": JKRDT_FULL, "baseline frictionless": JKRDT_BARE}
+PORTABLE = {f"portable {name}": pair.replace("pair_style jkr/dt", "pair_style jkr/dt kernel "
+                                             "portable")
+            for name, pair in (("full", JKRDT_FULL), ("frictionless", JKRDT_BARE))}
 CONFIGS = {"serial": (1, 1), "mpi2": (2, 1), "omp2": (1, 2), "skin20": (1, 1)}  # (ranks, threads)
 SKIN = {"skin20": 2.0e-8}                       # the neighbor skin where it is not 10 nm
 # the least memory traffic of one atom-step, in bytes: the pair loop reads x, v, omega,
@@ -164,7 +169,9 @@ def summarise(results: dict, sizes: list[int], configs: list[str]) -> dict:
                                ("jkr/dt frictionless", "plain copy"),
                                ("jkr/dt frictionless", "granular jkr"),
                                ("jkr/dt full", "baseline full"),
-                               ("jkr/dt frictionless", "baseline frictionless")):
+                               ("jkr/dt frictionless", "baseline frictionless"),
+                               ("jkr/dt full", "portable full"),
+                               ("jkr/dt frictionless", "portable frictionless")):
                 a, b = best(config, size, ours), best(config, size, peer)
                 if a and b:
                     cell[f"{ours} / {peer}"] = a / b
@@ -196,6 +203,8 @@ def main(argv=None):
                         help="atom-steps per run; steps = this / atoms (default 2e7)")
     parser.add_argument("--repeat", type=int, default=2)
     parser.add_argument("--baseline", type=Path, help="an older jkrdtplugin.so to compare with")
+    parser.add_argument("--portable", action="store_true",
+                        help="also run the two jkr/dt styles on the portable (SSE2) pair loop")
     parser.add_argument("--scenes", type=Path, default=Path("benchmarks/scenes"),
                         help="where the scenes are built once and kept (default: %(default)s)")
     parser.add_argument("--quick", action="store_true",
@@ -207,6 +216,8 @@ def main(argv=None):
     styles = dict(STYLES)
     if args.baseline:
         styles.update(BASELINE)
+    if args.portable:
+        styles.update(PORTABLE)
 
     dt = 0.014 * scales(ICE, R).t_c
     results: dict = {}
