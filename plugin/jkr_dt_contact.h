@@ -242,34 +242,39 @@ inline double breaking_loss(double delta, double vn, double dt, const NormalScal
 /* ----------------------------------------------------------------------
    a step that clamps or breaks books, per channel, what the loads' work over
    the step and the change of the channel's potential leave over
-   (step_dissipation). after: the state the step leaves and its
-   displacements, null when the contact breaks. Rare: kept out of the common
-   step's registers.
+   (step_dissipation). now, d: the state the step leaves and its
+   displacements (unused when the contact broke). Rare: kept out of line,
+   and given copies, so that the common step's values stay in registers.
 ------------------------------------------------------------------------- */
 
-[[gnu::noinline, gnu::cold]] inline void book_tangential_step(
-    const ContactConstants &c, const ContactMotion &m, double dt, const ContactState &before,
-    const ContactState &now, const Displacements *after, ContactResult &out)
+struct ChannelLosses {
+  double loss[NCHANNEL];
+};
+
+[[gnu::noinline, gnu::cold]] inline ChannelLosses book_tangential_step(
+    const ContactConstants &c, const ContactMotion m, double dt, const ContactState before,
+    const ContactState now, const Displacements d, bool broken)
 {
   const Tangential &K = c.K;
   const double R = c.S.R;
   const V3 nc = m.rinv * m.d12;    // eq. (9)
   ChannelLoad load[NCHANNEL], prev[NCHANNEL];
-  if (!after)
+  if (broken)
     for (int ch = 0; ch < NCHANNEL; ch++) load[ch] = {0.0, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
   else
-    tangential_load(now, *after, nc, m.rinv, c.r1, c.r2, R, K, load);  // eqs. (14)-(27)
+    tangential_load(now, d, nc, m.rinv, c.r1, c.r2, R, K, load);        // eqs. (14)-(27)
   const V3 dx12 = dt * m.v12;
   const V3 dtheta1 = dt * m.w1, dtheta2 = dt * m.w2;
   const V3 d12_before = m.d12 - dx12;
   const double rinv_before = 1.0 / norm(d12_before);
   tangential_load(before, rinv_before * d12_before, rinv_before, c.r1, c.r2, R, K, prev);
+  ChannelLosses booked;
   for (int ch = 0; ch < NCHANNEL; ch++) {
     const double w_before = channel_work(prev[ch], dx12, dtheta1, dtheta2);
     const double w_after = channel_work(load[ch], dx12, dtheta1, dtheta2);
-    out.loss[LOSS_SLIDING + ch] += step_dissipation(prev[ch].U, w_before, load[ch].U, w_after);
+    booked.loss[ch] = step_dissipation(prev[ch].U, w_before, load[ch].U, w_after);
   }
-  out.lossy = true;
+  return booked;
 }
 
 /* ----------------------------------------------------------------------
@@ -316,8 +321,12 @@ inline double breaking_loss(double delta, double vn, double dt, const NormalScal
     else
       clamped = clamp_to_elastic_limits(now, nc, c.r1, c.r2, R, K, d);
   }
-  if (traced && !setup && (breaking || clamped))
-    book_tangential_step(c, m, dt, before, now, breaking ? nullptr : &d, out);
+  if (traced && !setup && (breaking || clamped)) {
+    const ChannelLosses booked =
+        book_tangential_step(c, m, dt, before, now, breaking ? Displacements{} : d, breaking);
+    for (int ch = 0; ch < NCHANNEL; ch++) out.loss[LOSS_SLIDING + ch] += booked.loss[ch];
+    out.lossy = true;
+  }
   if (breaking) return;
   // the loads as every step computes them, so that a set-up reproduces the step's loads
   // bit for bit
