@@ -187,8 +187,8 @@ PairJKRDT::ConstantsBy PairJKRDT::constants_by()
 ------------------------------------------------------------------------- */
 
 template <bool TANGENTIAL>
-inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms, ConstantsBy by,
-                          Accumulator &acc)
+inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_atoms,
+                                 ConstantsBy by, Accumulator &acc)
 {
   using JKRDT::V3;
   // LAMMPS's per-atom 3-vectors are contiguous: index them flat, one load less per neighbor
@@ -393,10 +393,10 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
 /* ----------------------------------------------------------------------
    the loop compiled for any x86-64 and for AVX2: the same source, with the
    contact kernel's common path inlined (always_inline), so what differs is
-   the instructions only. The AVX2 loop inlines all it can (flatten): with
-   16 three-operand registers that saves a further 4 % of the instructions,
-   where SSE2 spills instead. What stays out of line (the rare clamped
-   step's bookkeeping, libm) is portable code.
+   the instructions only. The AVX2 loop also inlines all else it can
+   (flatten); the portable one does not, as SSE2 then spills more. What
+   stays out of line (the rare clamped step's bookkeeping, libm) is
+   portable code.
 ------------------------------------------------------------------------- */
 
 template <bool TANGENTIAL>
