@@ -54,6 +54,7 @@ struct Coefficients {
   double k_r;         // 4 F_c / R = 12 pi gamma (times kr_scale), eq. (22)
   double kt_coef;     // k_t / a0^3 = 16/3 Gred (times kt_scale), eq. (26)
   int sliding, rolling, twisting;
+  int damp_tension;    // 1: F_D of eq. (A.5) at every delta; 0: only while compressed (delta >= 0)
   bool tangential() const { return sliding || rolling || twisting; }
 };
 
@@ -66,6 +67,7 @@ struct ContactConstants {
   double inv_delta_c;   // 1 / delta_c
   double u_unit;        // F_c delta_c, the unit of U_n in eq. (6)
   double damp;          // damp_coef a0: F_D = damp y^2 v_n, eq. (A.5) with a = y^2 a0
+  bool damp_tension;    // F_D also while the contact is stretched (delta < 0)
   Tangential K;
   bool tangential;
 };
@@ -81,6 +83,7 @@ inline ContactConstants contact_constants(const Coefficients &P, double r1, doub
   c.inv_delta_c = 1.0 / c.S.delta_c;
   c.u_unit = c.S.F_c * c.S.delta_c;
   c.damp = P.damp_coef * c.S.a0;
+  c.damp_tension = P.damp_tension != 0;
   const double a0 = c.S.a0;
   c.K.sliding = P.sliding;
   c.K.rolling = P.rolling;
@@ -105,7 +108,7 @@ inline bool same_constants(const ContactConstants &a, const ContactConstants &b)
   for (int k = 0; k < 14; k++)
     if (!(x[k] == y[k] || (std::isnan(x[k]) && std::isnan(y[k])))) return false;
   return a.K.sliding == b.K.sliding && a.K.rolling == b.K.rolling &&
-      a.K.twisting == b.K.twisting;
+      a.K.twisting == b.K.twisting && a.damp_tension == b.damp_tension;
 }
 
 // where a contact's stored values sit: offsets into its values, -1 = not stored
@@ -382,7 +385,10 @@ struct NormalResult {
     // continued run equals an uninterrupted one. Its work over the step is the
     // trapezoid F_D(n) (v_n(n-1/2) + v_n(n+1/2)) dt / 2 of the two half-kicks
     const double fd_prev = formed ? 0.0 : state[L.fd];
-    const double fd = (setup && !formed) ? fd_prev : c.damp * y * y * vn;
+    // (damp_tension off: no F_D while the contact is stretched, delta < 0)
+    const double fd = (setup && !formed)          ? fd_prev
+        : (delta >= 0.0 || c.damp_tension) ? c.damp * y * y * vn
+                                           : 0.0;
     if (!setup) n.loss_damping = 0.5 * dt * (fd_prev + fd) * vn;
     state[L.fd] = fd;
     n.f -= fd;

@@ -39,7 +39,7 @@ class PairJKRDT : public Pair {
   // the pair_coeff keywords; their table (pair_jkr_dt_coeff.cpp) says how each is read,
   // checked, mixed and written to data and restart files
   enum Key { GAMMA, E, NU, G, XI_CRIT, TVIS, KS_SCALE, KR_SCALE, KT_SCALE,
-             SLIDING, ROLLING, TWISTING, NKEY };
+             SLIDING, ROLLING, TWISTING, DAMP_TENSION, NKEY };
   // what pair_coeff gave for one type pair, by keyword: NaN = not given; a switch is 1 or 0
   struct Input {
     double v[NKEY];

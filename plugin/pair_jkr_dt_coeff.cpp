@@ -4,6 +4,7 @@
      gamma <surface energy>   E <Young's modulus>   nu <Poisson ratio>
      G <shear modulus>        xi_crit <length>       tvis <time>
      sliding on|off   rolling on|off   twisting on|off   frictionless
+     damp_tension on|off   (off: no F_D of eq. A.5 while the contact is stretched, delta < 0)
      ks_scale <f>     kr_scale <f>     kt_scale <f>
 
    A type's own line (I = J) gives its material: gamma, E and nu are required,
@@ -80,6 +81,7 @@ constexpr Keyword KEYWORDS[PairJKRDT::NKEY] = {
     {PairJKRDT::SLIDING, "sliding", Value::SWITCH, Mix::BOTH_ON},
     {PairJKRDT::ROLLING, "rolling", Value::SWITCH, Mix::BOTH_ON},
     {PairJKRDT::TWISTING, "twisting", Value::SWITCH, Mix::BOTH_ON},
+    {PairJKRDT::DAMP_TENSION, "damp_tension", Value::SWITCH, Mix::BOTH_ON},
 };
 // keywords that are not values of a type pair
 constexpr const char *FRICTIONLESS = "frictionless";     // sliding, rolling, twisting off
@@ -310,6 +312,7 @@ PairJKRDT::Param PairJKRDT::resolve(int i, int j) const
   P.sliding = mixed(SLIDING) != 0.0;
   P.rolling = mixed(ROLLING) != 0.0;
   P.twisting = mixed(TWISTING) != 0.0;
+  P.damp_tension = mixed(DAMP_TENSION) != 0.0;
   // in 2D omega lies along z and n_c in the plane: the twisting angle of eq. (24) stays 0,
   // so the channel is off and its angle is not stored
   if (domain->dimension == 2) P.twisting = 0;
@@ -357,7 +360,8 @@ double PairJKRDT::init_one(int i, int j)
 // setflag and, if set, one double per keyword in that order. A file of the first builds
 // (positional: 9 doubles and 3 ints, no names) starts with the first setflag instead
 static constexpr int NAMED = -2;
-static constexpr int LEGACY_ORDER[PairJKRDT::NKEY] = {
+static constexpr int NLEGACY = 12;
+static constexpr int LEGACY_ORDER[NLEGACY] = {
     PairJKRDT::GAMMA,    PairJKRDT::E,        PairJKRDT::NU,       PairJKRDT::G,
     PairJKRDT::XI_CRIT,  PairJKRDT::TVIS,     PairJKRDT::KS_SCALE, PairJKRDT::KR_SCALE,
     PairJKRDT::KT_SCALE, PairJKRDT::SLIDING,  PairJKRDT::ROLLING,  PairJKRDT::TWISTING};
@@ -412,7 +416,7 @@ void PairJKRDT::read_restart(FILE *fp)
       order.push_back(k->key);
     }
   } else {
-    order.assign(LEGACY_ORDER, LEGACY_ORDER + NKEY);
+    order.assign(LEGACY_ORDER, LEGACY_ORDER + NLEGACY);
   }
   for (int i = 1; i <= atom->ntypes; i++)
     for (int j = i; j <= atom->ntypes; j++) {

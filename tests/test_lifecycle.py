@@ -454,3 +454,24 @@ def test_restart_files_name_their_coefficients_and_old_ones_read_back(tmp_path):
         assert coeff_lines(lmp, tmp_path / "named.coeff") == COEFFS_BY_POSITION
     finally:
         lmp.close()
+
+
+def test_a_restart_file_keeps_damp_tension_off(tmp_path):
+    # a keyword added after the restart records were named: written by name, it reads back
+    lmp = start_lammps()
+    try:
+        two_grain_scene(lmp, 2 * R_GRAIN - S.delta0,
+                        coeff_extra="frictionless tvis 6e-12 damp_tension off")
+        lmp.command("run 0")
+        lmp.command(f"write_restart {tmp_path / 'off.restart'}")
+    finally:
+        lmp.close()
+    assert b"damp_tension" in (tmp_path / "off.restart").read_bytes()
+    lmp = start_lammps()
+    try:
+        lmp.command(f"read_restart {tmp_path / 'off.restart'}")
+        assert coeff_lines(lmp, tmp_path / "off.coeff") == [
+            "pair_coeff 1 1 gamma 0.10000000000000001 E 7000000000 nu 0.25 "
+            "tvis 6.0000000000000003e-12 sliding off rolling off twisting off damp_tension off"]
+    finally:
+        lmp.close()

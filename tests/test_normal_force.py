@@ -112,3 +112,41 @@ def test_radii_changed_during_a_run_by_fix_adapt_follow_eq5(lmp):
     want = jkr_force(2 * grown - separation, s)
     assert want > S.F_c               # the old radii, at their equilibrium, give none
     assert -atom_force_x(lmp, 1) == pytest.approx(want, rel=1e-9)
+
+
+def contact_radius_ratio(delta, s):
+    """a / a0 of eq. (4) on the stable branch (a / a0 >= 6^(-2/3)), by bisection."""
+    lo, hi = 6 ** (-1 / 3), 2.0                  # y = (a / a0)^(1/2): delta / delta0 = 3 y^4 - 2 y
+    for _ in range(200):
+        y = 0.5 * (lo + hi)
+        lo, hi = (y, hi) if 3 * y ** 4 - 2 * y < delta / s.delta0 else (lo, y)
+    return lo * lo
+
+
+@pytest.mark.parametrize("damp_tension", ["on", "off"])
+@pytest.mark.parametrize("delta_over_delta0", [-0.4, 0.5])
+def test_damping_force_is_eq_A5_and_off_under_tension_with_damp_tension_off(lmp, damp_tension,
+                                                                           delta_over_delta0):
+    # a bonded contact held at delta, its grains moving apart at v_n = 1 m/s with nothing
+    # integrated: the force is eq. (5) minus F_D = 2 T_vis E* / nu^2 a v_n of eq. (A.5),
+    # which pulls against the separation. damp_tension off drops F_D while the contact is
+    # stretched (delta < 0) and keeps it while compressed
+    from jkrdt.materials import ICE
+    tvis, v_n = 6e-12, 1.0
+    extra = f"frictionless tvis {tvis!r} damp_tension {damp_tension}"
+    two_grain_scene(lmp, 2 * R_GRAIN - S.delta0, coeff_extra=extra)
+    lmp.command("run 0")                                   # the contact forms at delta0
+    lmp.command("unfix integrate")
+    delta = delta_over_delta0 * S.delta0
+    lmp.command(f"set atom 2 x {float(2 * R_GRAIN - delta)!r}")
+    lmp.command(f"set atom 1 vx {-0.5 * v_n!r}")
+    lmp.command(f"set atom 2 vx {0.5 * v_n!r}")
+    lmp.command("run 1")
+    Estar = ICE.E / (2 * (1 - ICE.nu ** 2))
+    f_d = 2 * tvis * Estar / ICE.nu ** 2 * contact_radius_ratio(delta, S) * S.a0 * v_n
+    if damp_tension == "off" and delta < 0:
+        f_d = 0.0
+    assert f_d == 0.0 or f_d > 0.05 * S.F_c                # a force the comparison resolves
+    assert -atom_force_x(lmp, 1) == pytest.approx(jkr_force(delta, S) - f_d, rel=1e-9,
+                                                  abs=1e-10 * S.F_c)
+    assert ledger(lmp)["p10"] == 1

@@ -46,6 +46,9 @@ class Material:
     xi_crit: float | None   # critical rolling displacement; None = rolling off
     G: float | None = None  # shear modulus; None = E / (2 (1 + nu))
     tvis: float = 0.0       # viscoelastic time scale of eq. (A.5); 0 = no damping
+    # F_D of eq. (A.5) also while a contact is stretched (delta < 0), as printed; False: only
+    # while compressed (the model variant of validation/damped_tension)
+    damp_tension: bool = True
 
     def __post_init__(self):
         for field in ("gamma", "E", "density"):

@@ -35,6 +35,8 @@ def pair_coeff(mat: Material, model: str = "frictional") -> str:
         words.append(f"G {mat.G!r}")
     if mat.tvis > 0:
         words.append(f"tvis {mat.tvis!r}")
+        if not mat.damp_tension:
+            words.append("damp_tension off")
     if model == "frictionless":
         words.append("frictionless")
     elif mat.xi_crit is None:
