@@ -109,16 +109,21 @@ def test_the_four_models_keep_the_papers_order(models):
 def test_two_grains_stick_at_the_elastic_threshold_and_far_above_it_with_damping(tmp_path):
     # validation/two_grain_sticking.py --quick: without damping the bisected threshold is
     # eq. (6)'s energy balance (a 1 % bracket, dt = 0.005 t_c moves it by < 0.1 %); T_vis
-    # = 6 ps of eq. (A.5) only adds dissipation, so the threshold can only rise
+    # = 6 ps of eq. (A.5) only adds dissipation, so the threshold can only rise; with F_D
+    # off while the contact is stretched (damp_tension off) less is dissipated than with it
+    # on and more than without damping, so the threshold lies between the two
     subprocess.run([sys.executable, str(ROOT / "validation" / "two_grain_sticking.py"),
                     "--quick", "--results", str(tmp_path)], check=True, timeout=300,
                    capture_output=True)
     summary = json.loads((tmp_path / "summary.json").read_text())
-    elastic, damped = summary["thresholds"]
+    elastic, damped, compressed_only = summary["thresholds"]
+    assert (damped["damp_tension"], compressed_only["damp_tension"]) == (True, False)
     v_el = summary["elastic_threshold"]
     assert v_el == pytest.approx(1.9345 * scales(ICE, 1e-7).v0, rel=1e-3)    # sqrt(3.742) v0
     assert elastic["v_stuck"] <= v_el * 1.003 and elastic["v_bounced"] >= v_el * 0.997
     assert damped["v_stuck"] > 2.0 * v_el
+    assert elastic["v_bounced"] < compressed_only["v_stuck"]
+    assert compressed_only["v_bounced"] < damped["v_stuck"]
     assert (tmp_path / "fig_threshold.png").stat().st_size > 0
 
 
@@ -209,6 +214,30 @@ def test_the_damped_dt_study_compares_two_steps_whose_ledgers_close(tmp_path):
     f = summary["results"]["frictionless, T_vis 6 ps"]["0.2500"]["f_gro"]
     mine = [r["growth_efficiency"] for r in runs if r["step"] == "dt auto"]
     assert f["at_auto"][0] == pytest.approx(np.mean(mine), abs=1e-12)
+    assert f["agree"] == (abs(f["difference"]) <= 2 * f["se"])
+
+
+def test_the_damped_tension_study_runs_the_variant_and_its_ledgers_close(tmp_path):
+    # validation/damped_tension.py --quick: damped frictional 2 x 24 ice BPCAs at 63.1
+    # m/s, B_off^2 3/12, 3 seeds, with eq. (A.5) as printed and with damp_tension off. Each
+    # variant's deck gives pair jkr/dt its own pair_coeff line; every run's energy ledger
+    # closes to --dt auto's tolerance with its damping booked (the variant's damping is
+    # booked as the printed one's); the comparison is the ensembles' difference against
+    # twice its standard error
+    results = run_quick("damped_tension", tmp_path)
+    summary = json.loads((results / "summary.json").read_text())
+    runs = read_csv(results / "runs.csv")
+    assert summary["runs"] == {"as printed": 3, "damp_tension off": 3}
+    assert max(r["energy_error"] for r in runs) < 1e-3
+    assert all(r["damping_share"] > 0 for r in runs)
+    for variant, folder in (("as printed", "as_printed"), ("damp_tension off", "damp_tension_off")):
+        decks = list((tmp_path / "runs").rglob(f"{folder}/*/*/*/in.collision.lmp"))
+        assert len(decks) == 3
+        assert all(("damp_tension off" in d.read_text()) == (variant != "as printed")
+                   for d in decks)
+    f = summary["results"]["0.2500"]["f_gro"]
+    mine = [r["growth_efficiency"] for r in runs if r["variant"] == "damp_tension off"]
+    assert f["damp_tension_off"][0] == pytest.approx(np.mean(mine), abs=1e-12)
     assert f["agree"] == (abs(f["difference"]) <= 2 * f["se"])
 
 

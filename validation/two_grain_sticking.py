@@ -15,6 +15,12 @@ H2O ice particles an order of magnitude above the elastic one); the ratio measur
 what that choice does to a single contact, the first thing to know when aggregates stick
 better than the paper finds.
 
+Each T_vis runs twice: with eq. (A.5) as printed, F_D at every delta of a bonded contact,
+and with the variant ``damp_tension off`` (pair_coeff), F_D only while the contact is
+compressed (delta >= 0): how eq. (A.5) treats a contact under tension is the one reading
+of the model that the paper leaves open, and the variant shows how much of the threshold
+the stretched contact's damping makes.
+
 Writes ``RESULTS`` (default validation/two_grain_sticking/): summary.json and
 fig_threshold (PNG, PDF).
 
@@ -55,10 +61,11 @@ def elastic_threshold(mat=ICE, radius=RADIUS) -> float:
     return math.sqrt(4.0 * (0.0893 + 0.8463) * s.F_c * s.delta_c / s.mass)
 
 
-def sticks(v_col: float, tvis: float, where: Path) -> bool:
+def sticks(v_col: float, tvis: float, where: Path, damp_tension: bool = True) -> bool:
     """Do two grains meeting head-on at ``v_col`` stay in contact once the collision has
     settled?"""
-    scene = scene_module.Scene(material("ice", tvis=tvis), 1, 1, v_col=v_col, b_off=0.0,
+    mat = material("ice", tvis=tvis, damp_tension=damp_tension)
+    scene = scene_module.Scene(mat, 1, 1, v_col=v_col, b_off=0.0,
                                seed=1, model="frictionless", radius=RADIUS,
                                dt_over_tc=DT_OVER_TC, dt_reason="two grains: the tests' step")
     rundir.write(where, scene, scene.collide(scene.aggregates()))
@@ -69,18 +76,19 @@ def sticks(v_col: float, tvis: float, where: Path) -> bool:
         return run.thermo()[ledger.CONTACTS][-1] > 0
 
 
-def threshold(tvis: float, width: float, where: Path) -> tuple[float, float | None, int]:
+def threshold(tvis: float, width: float, where: Path,
+              damp_tension: bool = True) -> tuple[float, float | None, int]:
     """The bracket (stuck, bounced) of the sticking threshold, bisected in log v_col down to
     ``width`` relative, and the number of runs it took; (V_MAX, None, runs) if the grains
     still stick at V_MAX."""
     lo, hi, runs = 0.5 * elastic_threshold(), 2.0 * elastic_threshold(), 0
-    while sticks(hi, tvis, where):          # widen until a run bounces
+    while sticks(hi, tvis, where, damp_tension):          # widen until a run bounces
         lo, hi, runs = hi, min(2.0 * hi, V_MAX), runs + 1
         if lo == V_MAX:
             return V_MAX, None, runs
     while hi / lo > 1.0 + width:
         mid = math.sqrt(lo * hi)
-        lo, hi = (mid, hi) if sticks(mid, tvis, where) else (lo, mid)
+        lo, hi = (mid, hi) if sticks(mid, tvis, where, damp_tension) else (lo, mid)
         runs += 1
     return lo, hi, runs + 1
 
@@ -90,24 +98,30 @@ def figure(rows: list[dict], v_el: float, results: Path) -> list[Path]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(5.5, 4))
-    found = [r for r in rows if r["v_bounced"] is not None]
-    always = [r for r in rows if r["v_bounced"] is None]
-    t = [r["tvis_ps"] for r in found]
-    v = [math.sqrt(r["v_stuck"] * r["v_bounced"]) for r in found]
-    ax.plot(t, v, "o-", color="C0", label="threshold (bisection)")
-    if always:
-        ax.plot([r["tvis_ps"] for r in always], [V_MAX] * len(always), "^", color="C3",
-                label=f"sticks at every v_col up to {V_MAX:g} m/s")
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    for tension, colour, what in ((True, "C0", "eq. (A.5) as printed"),
+                                  (False, "C1", "F_D only while compressed\n(damp_tension off)")):
+        mine = [r for r in rows if r.get("damp_tension", True) == tension]
+        found = [r for r in mine if r["v_bounced"] is not None]
+        always = [r for r in mine if r["v_bounced"] is None]
+        t = [r["tvis_ps"] for r in found]
+        v = [math.sqrt(r["v_stuck"] * r["v_bounced"]) for r in found]
+        ax.plot(t, v, "o-", color=colour, label=what)
+        if always:
+            ax.plot([r["tvis_ps"] for r in always], [V_MAX] * len(always), "^", color=colour,
+                    label=f"sticks at every v_col up to {V_MAX:g} m/s" if tension else None)
+        for x, y in zip(t, v):    # the threshold over the elastic one, at the paper's T_vis
+            if x == 6.0:
+                ax.annotate(f"{y / v_el:.1f}x", (x, y), textcoords="offset points",
+                            xytext=(-30 if tension else 6, 4 if tension else -12),
+                            color=colour)
     ax.axhline(v_el, color="grey", ls="--", label=f"elastic, eq. (6): {v_el:.2f} m/s")
     ax.axvline(6.0, color="C2", ls=":", label="the 3D BPCA paper's T_vis = 6 ps")
-    for x, y in zip(t, v):
-        ax.annotate(f"{y / v_el:.1f}x", (x, y), textcoords="offset points", xytext=(4, -12))
     ax.set_yscale("log")
     ax.set_xlabel("T_vis (ps), eq. (A.5)")
     ax.set_ylabel("sticking threshold v_col (m/s)")
     ax.set_title("two 0.1 micron ice grains, head-on")
-    ax.legend(loc="upper left")
+    ax.legend(loc="upper left", fontsize=8)
     fig.tight_layout()
     return save(fig, results, "fig_threshold")
 
@@ -127,16 +141,21 @@ def main(argv=None) -> int:
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         where = args.runs or Path(tmp)
-        for tvis in plan["tvis"]:
-            t0 = time.time()
-            lo, hi, runs = threshold(tvis, plan["width"], where)
-            rows.append(dict(tvis_ps=tvis * 1e12, v_stuck=lo, v_bounced=hi, runs=runs,
-                             over_elastic=None if hi is None else math.sqrt(lo * hi) / v_el))
-            said = (f"sticks at every v_col up to {V_MAX:g} m/s" if hi is None else
-                    f"sticks below {lo:.3f}-{hi:.3f} m/s ({rows[-1]['over_elastic']:.2f} x "
-                    "elastic)")
-            print(f"T_vis = {tvis * 1e12:g} ps: {said}, {runs} runs, {time.time() - t0:.0f} s",
-                  flush=True)
+        for tension in (True, False):
+            for tvis in plan["tvis"]:
+                if tvis == 0.0 and not tension:
+                    continue    # no damping: nothing to vary
+                t0 = time.time()
+                lo, hi, runs = threshold(tvis, plan["width"], where, tension)
+                rows.append(dict(tvis_ps=tvis * 1e12, damp_tension=tension, v_stuck=lo,
+                                 v_bounced=hi, runs=runs,
+                                 over_elastic=None if hi is None else
+                                 math.sqrt(lo * hi) / v_el))
+                said = (f"sticks at every v_col up to {V_MAX:g} m/s" if hi is None else
+                        f"sticks below {lo:.3f}-{hi:.3f} m/s "
+                        f"({rows[-1]['over_elastic']:.2f} x elastic)")
+                print(f"T_vis = {tvis * 1e12:g} ps, damp_tension {'on' if tension else 'off'}: "
+                      f"{said}, {runs} runs, {time.time() - t0:.0f} s", flush=True)
     summary = dict(material="ice", radius=RADIUS, model="frictionless", bracket=plan["width"],
                    dt_over_tc=DT_OVER_TC, v_max=V_MAX, elastic_threshold=v_el,
                    thresholds=rows)

@@ -135,14 +135,16 @@ def seed_spread(rows: list[dict]) -> list[float]:
 
 
 def outcome_rows(home: Path, n: int, model: str) -> list[dict]:
-    """One row per finished run below ``home``, with its loop time and its dt."""
-    return [dict(size=n, model=model, loop_seconds=loop_seconds(Path(o["run"])),
-                 dt_over_tc=rundir.read_metadata(o["run"])["dt_over_tc"],
+    """One row per finished run below ``home``, with its loop time and its dt. A run is
+    read where its outcome lies (the path an outcome records may be relative to where its
+    campaign was started)."""
+    return [dict(size=n, model=model, loop_seconds=loop_seconds(p.parent),
+                 dt_over_tc=rundir.read_metadata(p.parent)["dt_over_tc"],
                  **{k: o.get(k) for k in (
                      "v_col", "B_off", "seed", "n_total", "n_largest", "n_fragments",
                      "growth_efficiency", "stop_reason", "stop_step", "time_end_over_tc",
                      "energy_error", "kinetic_left")})
-            for o in (json.loads(p.read_text()) for p in sorted(home.rglob(rundir.OUTCOME)))]
+            for p in sorted(home.rglob(rundir.OUTCOME)) for o in [json.loads(p.read_text())]]
 
 
 def size_trend(rows: list[dict]) -> dict:
