@@ -19,14 +19,14 @@
 
 using namespace LAMMPS_NS;
 
-static constexpr int INITIAL_CAPACITY = 4;    // BPCA grains hold ~2 contacts; rows grow when one needs more
+static constexpr int INITIAL_CAPACITY = 2;    // a new row's room: BPCA grains hold ~2 contacts
 
 /* ---------------------------------------------------------------------- */
 
 FixJKRDTContacts::FixJKRDTContacts(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), npartner(nullptr), partner(nullptr), values(nullptr), ledger(nullptr),
     owner(nullptr), dnum(0), bonded(nullptr), slot_values(nullptr), slot_first(nullptr),
-    natoms_at_run_end(0), mask(0), maxpartner(INITIAL_CAPACITY), nmax_alloc(0),
+    natoms_at_run_end(0), mask(0), maxpartner(INITIAL_CAPACITY), nmax_alloc(0), capacity(nullptr),
     maxslot(0), slot_dnum(0), maxfirst(0), slot_list(nullptr), slot_build(-1), rows_stale(false),
     slot_nlocal(0)
 {
@@ -64,8 +64,9 @@ FixJKRDTContacts::~FixJKRDTContacts()
   atom->delete_callback(id, Atom::GROW);
   atom->delete_callback(id, Atom::RESTART);
   memory->destroy(npartner);
-  memory->destroy(partner);
-  memory->destroy(values);
+  memory->destroy(capacity);
+  memory->sfree(partner);    // arrays of row pointers (the rows are the arenas')
+  memory->sfree(values);
   memory->destroy(ledger);
   memory->destroy(owner);
   memory->destroy(bonded);
@@ -211,16 +212,16 @@ void FixJKRDTContacts::set_layout(int newmask)
   if (newmask == mask) return;
   const JKRDT::StateLayout next = JKRDT::state_layout(newmask);
   const int newdnum = next.dnum;
-  const int nmax = nmax_alloc;
-
-  double **newvalues = nullptr;
-  if (newdnum > 0) memory->create(newvalues, nmax, maxpartner * newdnum, "jkr/dt:values");
-  for (int i = 0; i < atom->nlocal && newvalues; i++)
-    for (int k = 0; k < npartner[i]; k++)
-      JKRDT::relayout(values ? values[i] + k * dnum : nullptr, state, newvalues[i] + k * newdnum,
-                      next);
-  memory->destroy(values);
-  values = newvalues;
+  // the owned atoms' values into a fresh arena, each row as long as its segment
+  JKRDT::Arena<double> vals;
+  for (int i = 0; i < atom->nlocal; i++) {
+    double *row = (newdnum && capacity[i]) ? vals.take((size_t) capacity[i] * newdnum) : nullptr;
+    for (int k = 0; row && k < npartner[i]; k++)
+      JKRDT::relayout(dnum ? values[i] + k * dnum : nullptr, state, row + k * newdnum, next);
+    values[i] = row;
+  }
+  for (int i = atom->nlocal; i < nmax_alloc; i++) fresh(i);
+  value_arena.swap(vals);
   mask = newmask;
   state = next;
   dnum = newdnum;
@@ -332,6 +333,20 @@ void FixJKRDTContacts::to_slots(const NeighList *list)
   slot_tag.assign(tag, tag + nlocal + atom->nghost);
 }
 
+// fn(i, j, s) for each bonded slot s of the list, i and j its atoms (i owned)
+template <typename F>
+static void each_bonded_slot(const NeighList *list, const int *slot_first,
+                             const unsigned char *bonded, F fn)
+{
+  for (int ii = 0; ii < list->inum; ii++) {
+    const int i = list->ilist[ii];
+    const int *jlist = list->firstneigh[i];
+    bigint s = slot_first[ii];
+    for (int jj = 0; jj < list->numneigh[i]; jj++, s++)
+      if (bonded[s]) fn(i, jlist[jj] & NEIGHMASK, s);
+  }
+}
+
 /* ----------------------------------------------------------------------
    slots -> rows: each owned atom's row becomes the bonded slots it is in
 ------------------------------------------------------------------------- */
@@ -348,23 +363,48 @@ void FixJKRDTContacts::to_rows()
     error->one(FLERR, "pair jkr/dt: atoms left this rank before their contacts were written "
                       "back (internal error)");
   const tagint *tag = slot_tag.data();
-  for (int i = 0; i < nlocal; i++) npartner[i] = 0;
-  for (int ii = 0; ii < list->inum; ii++) {
-    const int i = list->ilist[ii];
-    const int *jlist = list->firstneigh[i];
-    int s = slot_first[ii];
-    for (int jj = 0; jj < list->numneigh[i]; jj++, s++) {
-      if (!bonded[s]) continue;
-      const int j = jlist[jj] & NEIGHMASK;
-      const double *v = dnum ? slot_values + (bigint) s * dnum : nullptr;
-      double *row = add(i, tag[j]);
-      if (v) std::copy_n(v, dnum, row);
-      if (j < nlocal) {
-        row = add(j, tag[i]);
-        if (v) std::copy_n(v, dnum, row);
-      }
-    }
+
+  // a fresh arena, tight: each atom of the list gets room for its bonded slots, and an
+  // atom that arrived since keeps its row; every other row pointer is dropped
+  std::vector<int> count(nlocal, 0);
+  each_bonded_slot(list, slot_first, bonded, [&](int i, int j, bigint) {
+    count[i]++;
+    if (j < nlocal) count[j]++;
+  });
+  JKRDT::Arena<tagint> tags;
+  JKRDT::Arena<double> vals;
+  auto place = [&](int i, int n) {
+    partner[i] = n ? tags.take(n) : nullptr;
+    values[i] = (n && dnum) ? vals.take((size_t) n * dnum) : nullptr;
+    capacity[i] = n;
+  };
+  for (int i = nlocal; i < atom->nlocal; i++) {
+    const tagint *p = partner[i];
+    const double *v = values[i];
+    place(i, npartner[i]);
+    std::copy_n(p, npartner[i], partner[i]);
+    if (dnum) std::copy_n(v, (size_t) npartner[i] * dnum, values[i]);
   }
+  int longest = 0;
+  for (int i = 0; i < nlocal; i++) {
+    place(i, count[i]);
+    npartner[i] = 0;
+    longest = std::max(longest, count[i]);
+  }
+  for (int i = atom->nlocal; i < nmax_alloc; i++) fresh(i);
+  tag_arena.swap(tags);
+  value_arena.swap(vals);
+  longest_row(longest);
+
+  each_bonded_slot(list, slot_first, bonded, [&](int i, int j, bigint s) {
+    const double *v = dnum ? slot_values + s * dnum : nullptr;
+    double *row = add(i, tag[j]);
+    if (v) std::copy_n(v, dnum, row);
+    if (j < nlocal) {
+      row = add(j, tag[i]);
+      if (v) std::copy_n(v, dnum, row);
+    }
+  });
 }
 
 /* ----------------------------------------------------------------------
@@ -381,7 +421,7 @@ int FixJKRDTContacts::find(int i, tagint partner_tag) const
 
 double *FixJKRDTContacts::add(int i, tagint partner_tag)
 {
-  if (npartner[i] == maxpartner) grow_partner_capacity(maxpartner + 1);
+  reserve(i, npartner[i] + 1);
   owner[i] = atom->tag[i];
   const int k = npartner[i]++;
   partner[i][k] = partner_tag;
@@ -400,29 +440,37 @@ void FixJKRDTContacts::remove(int i, int k)
 }
 
 /* ----------------------------------------------------------------------
-   a rank's per-atom capacity grows whenever one atom needs more room;
-   it never drops a contact
+   an atom's row grows into a new segment, twice as long, and keeps its
+   contacts; the old segment stays in the arena until the next rewrite
 ------------------------------------------------------------------------- */
 
-void FixJKRDTContacts::grow_partner_capacity(int needed)
+void FixJKRDTContacts::reserve(int i, int n)
 {
-  if (needed <= maxpartner) return;
-  const int newmax = std::max(needed, maxpartner + maxpartner / 2);
-  const int nmax = nmax_alloc;
-
-  tagint **newpartner = nullptr;
-  double **newvalues = nullptr;
-  memory->create(newpartner, nmax, newmax, "jkr/dt:partner");
-  if (dnum) memory->create(newvalues, nmax, newmax * dnum, "jkr/dt:values");
-  for (int i = 0; i < nmax; i++) {
-    std::copy_n(partner[i], npartner[i], newpartner[i]);
-    if (dnum) std::copy_n(values[i], npartner[i] * dnum, newvalues[i]);
+  if (n <= capacity[i]) return;
+  const int room = std::max({n, 2 * capacity[i], INITIAL_CAPACITY});
+  tagint *p = tag_arena.take(room);
+  std::copy_n(partner[i], npartner[i], p);
+  partner[i] = p;
+  if (dnum) {
+    double *v = value_arena.take((size_t) room * dnum);
+    std::copy_n(values[i], (size_t) npartner[i] * dnum, v);
+    values[i] = v;
   }
-  memory->destroy(partner);
-  memory->destroy(values);
-  partner = newpartner;
-  values = newvalues;
-  maxpartner = newmax;
+  capacity[i] = room;
+  longest_row(n);
+}
+
+void FixJKRDTContacts::fresh(int i)
+{
+  npartner[i] = capacity[i] = 0;
+  partner[i] = nullptr;
+  values[i] = nullptr;
+}
+
+void FixJKRDTContacts::longest_row(int n)
+{
+  if (n <= maxpartner) return;
+  maxpartner = std::max(n, maxpartner + maxpartner / 2);
   set_exchange_size();
 }
 
@@ -441,8 +489,9 @@ void FixJKRDTContacts::grow_arrays(int nmax)
 {
   const int oldmax = nmax_alloc;
   memory->grow(npartner, nmax, "jkr/dt:npartner");
-  memory->grow(partner, nmax, maxpartner, "jkr/dt:partner");
-  if (dnum) memory->grow(values, nmax, maxpartner * dnum, "jkr/dt:values");
+  memory->grow(capacity, nmax, "jkr/dt:capacity");
+  partner = (tagint **) memory->srealloc(partner, sizeof(tagint *) * nmax, "jkr/dt:partner");
+  values = (double **) memory->srealloc(values, sizeof(double *) * nmax, "jkr/dt:values");
   memory->grow(ledger, nmax, NLEDGER, "jkr/dt:ledger");
   memory->grow(owner, nmax, "jkr/dt:owner");
   nmax_alloc = nmax;
@@ -453,16 +502,19 @@ void FixJKRDTContacts::grow_arrays(int nmax)
 void FixJKRDTContacts::copy_arrays(int i, int j, int /*delflag*/)
 {
   to_rows();    // atoms are about to be moved (sort, deletion): the rows take the state first
+  // j takes i's row segment; i is overwritten or gone next (sorting, deletion), and a
+  // new atom in its place starts a row of its own (set_arrays, unpack_exchange)
   npartner[j] = npartner[i];
-  std::copy_n(partner[i], npartner[i], partner[j]);
-  if (dnum) std::copy_n(values[i], npartner[i] * dnum, values[j]);
+  capacity[j] = capacity[i];
+  partner[j] = partner[i];
+  values[j] = values[i];
   std::copy_n(ledger[i], (int) NLEDGER, ledger[j]);
   owner[j] = owner[i];
 }
 
 void FixJKRDTContacts::set_arrays(int i)
 {
-  npartner[i] = 0;
+  fresh(i);
   owner[i] = 0;
   std::fill(ledger[i], ledger[i] + NLEDGER, 0.0);
 }
@@ -487,7 +539,8 @@ int FixJKRDTContacts::unpack_exchange(int nlocal, double *buf)
 {
   int m = 0;
   const int n = static_cast<int>(buf[m++]);
-  grow_partner_capacity(n);
+  fresh(nlocal);
+  reserve(nlocal, n);
   npartner[nlocal] = n;
   for (int k = 0; k < n; k++) partner[nlocal][k] = (tagint) ubuf(buf[m++]).i;
   for (int k = 0; k < n * dnum; k++) values[nlocal][k] = buf[m++];
@@ -521,7 +574,8 @@ void FixJKRDTContacts::unpack_restart(int nlocal, int nth)
   const JKRDT::StateLayout file = JKRDT::state_layout(static_cast<int>(*buf++));
   const int filednum = file.dnum;
   const int n = static_cast<int>(*buf++);
-  grow_partner_capacity(n);
+  fresh(nlocal);
+  reserve(nlocal, n);
   npartner[nlocal] = n;
   for (int k = 0; k < n; k++) partner[nlocal][k] = (tagint) ubuf(*buf++).i;
   for (int k = 0; k < n; k++, buf += filednum) {
@@ -581,8 +635,8 @@ void FixJKRDTContacts::restart(char *buf)
 double FixJKRDTContacts::memory_usage()
 {
   const double nmax = nmax_alloc;
-  return nmax *
-      (sizeof(int) + maxpartner * (sizeof(tagint) + dnum * sizeof(double)) +
-       NLEDGER * sizeof(double) + sizeof(tagint)) +
+  return nmax * (2 * sizeof(int) + sizeof(tagint *) + sizeof(double *) +
+                 NLEDGER * sizeof(double) + sizeof(tagint)) +
+      (double) tag_arena.bytes() + (double) value_arena.bytes() +
       (double) maxslot * (1 + slot_dnum * sizeof(double)) + (double) maxfirst * sizeof(int);
 }

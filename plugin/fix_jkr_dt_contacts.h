@@ -8,7 +8,11 @@
    Where atoms can move between MPI ranks, be sorted, deleted or written to
    a restart file, the state lives per atom: every bonded contact stored
    twice, once with each of its two atoms, as (partner ID, per-contact
-   values). This form moves with its atom between ranks (pack/unpack_exchange),
+   values). An atom's row is a segment of a chunked arena (jkr_dt_arena.h)
+   as long as its own contacts, so the rows' memory follows the contacts, not
+   the most contacts of any atom times the atoms; sorting and deletion move an
+   atom's row pointers, not its values, and each rewrite of the rows from the
+   slots builds the arena afresh, tight. This form moves with its atom between ranks (pack/unpack_exchange),
    follows atom sorting and deletion (copy_arrays) and goes into restart
    files (pack/unpack_restart).
 
@@ -47,6 +51,7 @@
 
 #include "fix.h"
 
+#include "jkr_dt_arena.h"
 #include "jkr_dt_contact.h"
 
 #include <functional>
@@ -128,8 +133,8 @@ class FixJKRDTContacts : public Fix {
   double memory_usage() override;
 
   int *npartner;        // number of bonded contacts of each atom
-  tagint **partner;     // atom IDs of the partners
-  double **values;      // per-contact values, dnum per contact
+  tagint **partner;     // atom IDs of the partners (each atom's row, in tag_arena)
+  double **values;      // per-contact values, dnum per contact (in value_arena)
   double **ledger;      // dissipated energy by channel, NLEDGER per atom
   tagint *owner;        // the atom's ID when its contacts were stored (renumbering check)
   int dnum;             // doubles per contact under the current layout
@@ -145,10 +150,15 @@ class FixJKRDTContacts : public Fix {
  private:
   int mask;             // bit f set = field f stored
   JKRDT::StateLayout state;    // where the fields sit among a contact's dnum values
-  int maxpartner;       // row capacity of partner/values on this rank
+  int maxpartner;       // the longest row this rank has held (sizes an exchange record)
   int nmax_alloc;       // rows allocated in the per-atom arrays
+  int *capacity;        // contacts each atom's row segment has room for
+  JKRDT::Arena<tagint> tag_arena;
+  JKRDT::Arena<double> value_arena;
 
-  void grow_partner_capacity(int needed);
+  void reserve(int i, int n);     // room for n contacts in atom i's row, keeping its own
+  void fresh(int i);              // atom i's row empty, sharing no segment
+  void longest_row(int n);        // a row of n contacts exists: exchange records fit it
   void set_exchange_size();
   int maxslot, slot_dnum;           // slots allocated, values per allocated slot
   int maxfirst;                     // ilist entries allocated

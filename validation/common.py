@@ -86,6 +86,14 @@ def save(fig, results: Path, stem: str) -> list[Path]:
     return out
 
 
+def write_summary(results: Path, summary: dict) -> int:
+    """A study's summary.json in ``results``, its "results" part printed; 0, the study's
+    exit status."""
+    (results / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    print(json.dumps(summary["results"], indent=1))
+    return 0
+
+
 def mean_se(values) -> tuple[float, float]:
     """An ensemble's mean and the standard error of that mean (NaN for one value)."""
     x = np.asarray(values, dtype=float)

@@ -20,12 +20,11 @@ Writes RESULTS (default validation/damped_dt/): runs.csv and summary.json.
 
 from __future__ import annotations
 
-import json
 import sys
 
 from bpca3d_models import DT, model_spec
 from common import (campaign_paths, campaign_study_parser, mean_se, run_campaigns,
-                    study_paths, within_scatter)
+                    study_paths, within_scatter, write_summary)
 from jkrdt.analysis.tables import write_csv
 from jkrdt.stopping import COMPLETE
 from vfra_size import TOLERANCE, model_home, outcome_rows
@@ -93,9 +92,7 @@ def main(argv=None) -> int:
         energy_error_max={name: max((r["energy_error"] for r in rows if r["step"] == name),
                                     default=None) for name in STEPS},
         runs_finished=len(rows))
-    (results / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
-    print(json.dumps(summary["results"], indent=1))
-    return 0
+    return write_summary(results, summary)
 
 
 if __name__ == "__main__":

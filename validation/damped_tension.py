@@ -29,7 +29,7 @@ from pathlib import Path
 
 from bpca3d_models import model_spec
 from common import (campaign_paths, campaign_study_parser, mean_se, run_campaigns,
-                    study_paths, within_scatter)
+                    study_paths, within_scatter, write_summary)
 from jkrdt import rundir
 from jkrdt.analysis.tables import write_csv
 from jkrdt.stopping import COMPLETE
@@ -91,9 +91,7 @@ def main(argv=None) -> int:
                                            if r["variant"] == name) / 60 for name in VARIANTS},
                    energy_error_max=max((r["energy_error"] for r in rows), default=None),
                    runs_finished=len(rows))
-    (results / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
-    print(json.dumps(summary["results"], indent=1))
-    return 0
+    return write_summary(results, summary)
 
 
 if __name__ == "__main__":
