@@ -6,6 +6,7 @@ two grains without and with the damping of eq. A.5) and validation/departure.py 
 that depart against fragments kept flying, 2 x 50 grains shattering, 4 seeds)."""
 
 import json
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -192,6 +193,14 @@ def test_the_size_study_places_v_fra_and_runs_seed_2_where_it_lies(tmp_path):
         assert c["seeds_v_fra"] and all(grid[0] < v < grid[-1] for v in c["seeds_v_fra"])
     # the 3D paper's order: without friction the aggregates break at lower speed
     assert at["frictionless"]["v_fra"] < at["frictional"]["v_fra"]
+    # the committed runs.csv is the study's ledger: on a machine that lost the runs, a
+    # second call runs none of them again and writes the same table and summary
+    shutil.rmtree(tmp_path / "runs")
+    table = (results / "runs.csv").read_text()
+    run_quick("vfra_size", tmp_path)
+    assert not (tmp_path / "runs").exists()
+    assert (results / "runs.csv").read_text() == table
+    assert json.loads((results / "summary.json").read_text())["sizes"] == summary["sizes"]
 
 
 def test_the_damped_dt_study_compares_two_steps_whose_ledgers_close(tmp_path):

@@ -23,7 +23,7 @@ max |dE| / E_imp <= 1e-3 (TOLERANCE): the trade study (benchmarks/tradeoff) foun
 outcome moving beyond its scatter up to 0.2 t_c, where the worst run's error was 6.5e-3.
 
 Writes RESULTS (default validation/vfra_size/), from every finished run below RUNS
-whichever call ran it: runs.csv (every run, with its loop time), summary.json (per size
+whichever call ran it and every run the committed RESULTS/runs.csv already lists: runs.csv (every run, with its loop time), summary.json (per size
 and model: <f_gro> against v_col, v_fra with its bracket, the compute spent; the trend of
 v_fra against N; the paper-size collisions), fig_vfra_size and fig_growth_size
 (<f_gro> against v_col per model, a line per size).
@@ -33,6 +33,11 @@ v_fra against N; the paper-size collisions), fig_vfra_size and fig_growth_size
     ./run validate vfra_size --paper-size 0 0.5  # 2 x 50000: B_off^2 0 and 6/12 of PAPER_SIZE
     ./run validate vfra_size --sizes 10000
     ./run validate vfra_size --quick            # 2 x 24 grains, two models (tests)
+
+The committed runs.csv is the study's ledger: a campaign whose every run it lists is not
+run again, and its rows stay in the results, so a machine that lost RUNS (a new checkout,
+a wiped disk) goes on where the last committed results stopped instead of redoing hours of
+runs; of a campaign that the ledger holds in part, only the speeds it lacks run again.
 """
 
 from __future__ import annotations
@@ -46,8 +51,9 @@ from pathlib import Path
 import numpy as np
 
 from bpca3d_models import FULL as SMALLER_PLAN, MODELS, model_spec
-from common import HERE, campaign_study_parser, loop_seconds, run_campaigns, save, study_paths
-from jkrdt import campaign as campaign_module, rundir
+from common import (HERE, campaign_paths, campaign_study_parser, loop_seconds, run_campaigns,
+                    save, study_paths)
+from jkrdt import rundir
 from jkrdt.analysis.summary import b_off_mean, threshold_velocity
 from jkrdt.analysis.tables import read_csv, write_csv
 from jkrdt.stopping import COMPLETE
@@ -145,6 +151,59 @@ def outcome_rows(home: Path, n: int, model: str) -> list[dict]:
                      "growth_efficiency", "stop_reason", "stop_step", "time_end_over_tc",
                      "energy_error", "kinetic_left")})
             for p in sorted(home.rglob(rundir.OUTCOME)) for o in [json.loads(p.read_text())]]
+
+
+#: the columns of runs.csv that hold whole numbers
+INTS = ("size", "seed", "n_total", "n_largest", "n_fragments", "stop_step")
+
+
+def row_key(r: dict) -> tuple:
+    """What tells one run of the study from another: size, model, seed, v_col, B_off^2."""
+    return (int(r["size"]), r["model"], int(r["seed"]), round(float(r["v_col"]), 4),
+            round(float(r["B_off"]) ** 2, 4))
+
+
+def read_ledger(results: Path) -> list[dict]:
+    """The runs the committed ``results/runs.csv`` lists (none if there is none yet)."""
+    path = results / "runs.csv"
+    if not path.exists():
+        return []
+    return [{k: int(v) if k in INTS and v != "" else v for k, v in r.items()}
+            for r in read_csv(path)]
+
+
+def finished(home: Path, n: int, model: str, ledger: list[dict], seed: int | None = None,
+             speeds: list[float] | None = None) -> list[dict]:
+    """The finished runs of ``model`` at 2 x ``n`` (of ``seed`` and at ``speeds`` if
+    given): those below ``home`` and the ledger's that the disk does not hold."""
+    at = None if speeds is None else {round(v, 4) for v in speeds}
+
+    def wanted(r):
+        return (r["size"] == n and r["model"] == model and seed in (None, r["seed"])
+                and (at is None or round(r["v_col"], 4) in at))
+
+    disk = [r for r in outcome_rows(home, n, model) if wanted(r)]
+    seen = {row_key(r) for r in disk}
+    return disk + [r for r in ledger if wanted(r) and row_key(r) not in seen]
+
+
+def campaign(name: str, model: str, n: int, speeds: list[float], b_off2: list[float],
+             seed: int, home: Path, ranks: int, ledger: list[dict]) -> list[dict]:
+    """The campaign ``home/name`` of ``seed`` at ``speeds`` x ``b_off2``, unless its every
+    run is finished; its finished runs. Where the ledger holds some of its speeds and the
+    campaign is not on disk (a new machine), each speed it lacks runs as a campaign of its
+    own (``name_v<speed>``)."""
+    held = {row_key(r) for r in finished(home, n, model, ledger, seed, speeds)}
+    missing = [v for v in speeds if any((n, model, seed, round(v, 4), round(b2, 4))
+                                        not in held for b2 in b_off2)]
+    if not missing:
+        print(f"{name}: every run finished (on disk or in the committed runs.csv)", flush=True)
+    elif campaign_paths({name: None}, home)[name].exists() or missing == speeds:
+        run_campaigns({name: spec(model, n, speeds, b_off2, seed)}, home, ranks)
+    else:
+        for v in missing:
+            run_campaigns({f"{name}_v{v:g}": spec(model, n, [v], b_off2, seed)}, home, ranks)
+    return finished(home, n, model, ledger, seed, speeds)
 
 
 def size_trend(rows: list[dict]) -> dict:
@@ -284,33 +343,31 @@ def model_home(runs: Path, n: int, model: str) -> Path:
     return runs / f"n{n}" / model.replace(", ", "_").replace(" ", "_")
 
 
-def run_model(model: str, n: int, plan: dict, runs: Path, ranks: int) -> None:
+def run_model(model: str, n: int, plan: dict, runs: Path, ranks: int,
+              ledger: list[dict]) -> None:
     """Phase 1, its extension and phase 2 (with its follow-up) of one model at 2 x ``n``."""
-    grid = plan["grids"][model]
+    grid, offsets = plan["grids"][model], plan["b_off2"]
     home = model_home(runs, n, model)
     first = f"seed{SEEDS[0]}"
-    run_campaigns({first: spec(model, n, grid, plan["b_off2"], SEEDS[0])}, home, ranks)
-    rows = outcome_rows(home / first, n, model)
+    rows = campaign(first, model, n, grid, offsets, SEEDS[0], home, ranks, ledger)
     for _ in range(plan["extend"]):
         speed = next_speed(curve(rows))
         if speed is None:
             break
-        name = f"{first}_v{speed:g}"
-        run_campaigns({name: spec(model, n, [speed], plan["b_off2"], SEEDS[0])}, home, ranks)
-        rows += outcome_rows(home / name, n, model)
+        rows += campaign(f"{first}_v{speed:g}", model, n, [speed], offsets, SEEDS[0], home,
+                         ranks, ledger)
     second = f"seed{SEEDS[1]}"
-    run_campaigns({second: spec(model, n, nearest_two(curve(rows)), plan["b_off2"],
-                                SEEDS[1])}, home, ranks)
+    campaign(second, model, n, nearest_two(curve(rows)), offsets, SEEDS[1], home, ranks,
+             ledger)
     # seed 2 may move v_fra out of seed 1's bracket: seed 2 then runs at the new bracket's
     # speeds too, so that both seeds stand at the two speeds nearest v_fra
     for _ in range(plan["follow"]):
-        rows = outcome_rows(home, n, model)
-        missing = seed_2_missing(rows, len(plan["b_off2"]))
+        missing = seed_2_missing(finished(home, n, model, ledger), len(offsets))
         if not missing:
             break
         for speed in missing:
-            run_campaigns({f"{second}_v{speed:g}": spec(model, n, [speed], plan["b_off2"],
-                                                         SEEDS[1])}, home, ranks)
+            campaign(f"{second}_v{speed:g}", model, n, [speed], offsets, SEEDS[1], home,
+                     ranks, ledger)
 
 
 def seed_2_missing(rows: list[dict], offsets: int) -> list[float]:
@@ -320,14 +377,14 @@ def seed_2_missing(rows: list[dict], offsets: int) -> list[float]:
             if sum(r["seed"] == SEEDS[1] and r["v_col"] == v for r in rows) < offsets]
 
 
-def run_paper_size(runs: Path, ranks: int, b_off2: list[float]) -> None:
+def run_paper_size(runs: Path, ranks: int, b_off2: list[float], ledger: list[dict]) -> None:
     """The 12 collisions of PAPER_SIZE at 2 x 50000 grains, seed 1, the offsets ``b_off2``
     of each model before the next offsets of any (one campaign per model and offsets)."""
     n = PAPER_SIZE["n"]
     for b2 in b_off2:
         for model, v in PAPER_SIZE["speeds"].items():
-            run_campaigns({f"v{v:g}_b2_{b2:.4f}": spec(model, n, [v], [b2], SEEDS[0])},
-                          model_home(runs, n, model), ranks)
+            campaign(f"v{v:g}_b2_{b2:.4f}", model, n, [v], [b2], SEEDS[0],
+                     model_home(runs, n, model), ranks, ledger)
 
 
 def size_summary(mine: list[dict], model: str) -> dict:
@@ -382,22 +439,22 @@ def main(argv=None) -> int:
     if args.paper_size is not None and not set(args.paper_size) <= set(PAPER_SIZE["b_off2"]):
         p.error(f"--paper-size takes B_off^2 of {PAPER_SIZE['b_off2']}")
     runs, results = study_paths(args, "vfra_size")
+    ledger = read_ledger(results)
     t0 = time.time()
     if args.paper_size is not None:
-        run_paper_size(runs, args.np, args.paper_size or PAPER_SIZE["b_off2"])
+        run_paper_size(runs, args.np, args.paper_size or PAPER_SIZE["b_off2"], ledger)
     else:
         for n in plan["sizes"]:
             for model in args.models or plan["grids"]:
-                run_model(model, n, plan, runs, args.np)
-    # every finished run below RUNS goes into runs.csv, whichever call ran it; a model
-    # enters the summary, the trend and the figures once its seed 2 has run (before that
-    # its curve is phase 1's so far), and is listed as under way until then
+                run_model(model, n, plan, runs, args.np, ledger)
+    # every finished run below RUNS or in the ledger goes into runs.csv, whichever call
+    # ran it; a model enters the summary, the trend and the figures once its seed 2 has
+    # run (before that its curve is phase 1's so far), and is listed as under way until then
     rows, sizes, under_way = [], {}, {}
     for n in plan["sizes"]:
         for model in plan["grids"]:
-            home = model_home(runs, n, model)
-            mine = outcome_rows(home, n, model)
-            done = (home / f"seed{SEEDS[1]}" / campaign_module.SPEC_RECORD).exists() and \
+            mine = finished(model_home(runs, n, model), n, model, ledger)
+            done = any(r["seed"] == SEEDS[1] for r in mine) and \
                 not (plan["follow"] and seed_2_missing(mine, len(plan["b_off2"])))
             if done:
                 rows += mine
@@ -405,7 +462,7 @@ def main(argv=None) -> int:
             elif mine:
                 under_way.setdefault(str(n), {})[model] = mine
     large = [r for model in PAPER_SIZE["speeds"] for r in
-             outcome_rows(model_home(runs, PAPER_SIZE["n"], model), PAPER_SIZE["n"], model)]
+             finished(model_home(runs, PAPER_SIZE["n"], model), PAPER_SIZE["n"], model, ledger)]
     write_csv(results / "runs.csv", rows + [r for m in under_way.values() for x in m.values()
                                             for r in x] + large)
     # the size trend: the committed smaller sizes of bpca3d_models with these (not in the
