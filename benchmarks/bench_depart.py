@@ -40,8 +40,9 @@ def main(argv=None) -> None:
                     help="simulated time (t_c) at which both stop, settled or not")
     ap.add_argument("--out", type=Path, default=HERE / "depart" / "depart.json")
     ap.add_argument("--neighbor", action="store_true",
-                    help="compare instead bins against nsq, both departing (the small-scene "
-                         "special case, jkrdt.scene.NSQ_MAX)")
+                    help="compare instead bins against nsq, both departing and neither sorting "
+                         "its atoms (nsq was the path of scenes up to 2000 grains until "
+                         "bins were bounded; jkrdt.rundir.SORT_MIN)")
     args = ap.parse_args(argv)
 
     from jkrdt import rundir
@@ -53,7 +54,7 @@ def main(argv=None) -> None:
                             model=args.model, seed=args.seed)
     rundir.write(work / "scene", sc)
     variants = (dict(yes=dict(depart="yes"), no=dict(depart="no")) if not args.neighbor else
-                dict(yes=dict(depart="yes", neighbor="bin", sort="1000 0.0"),
+                dict(yes=dict(depart="yes", neighbor="bin", sort="0 0.0"),
                      no=dict(depart="yes", neighbor="nsq", sort="0 0.0")))
     # the run without departure (or with nsq) has the budget; the other runs to its end
     budget = dict(yes=float("inf"), no=args.budget)

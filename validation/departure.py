@@ -2,7 +2,7 @@
 
 Two equal ice BPCAs collide head-on at 20, 39.8 and 100 m/s under the frictional and the
 frictionless model, 8 seeds each, twice: with departures, and with every fragment kept
-moving (``depart shadow``: the run of the 2000-grain nsq path as before, which also logs
+moving (``depart shadow``: every fragment flies on as before departures, and the log names
 when the rule would have let each fragment go). Collisions are chaotic, so the two are
 compared as ensembles: for each model and speed, the seeds' mean and standard error of
 f_gro, N_lar / N and N_cum(<= 1, 4, 16) / N, and whether the two means lie within two
