@@ -42,7 +42,7 @@ def main(argv=None) -> None:
     ap.add_argument("--neighbor", action="store_true",
                     help="compare instead bins against nsq, both departing and neither sorting "
                          "its atoms (nsq was the path of scenes up to 2000 grains until "
-                         "bins were bounded; jkrdt.rundir.SORT_MIN)")
+                         "bins were bounded; jkrdt.rundir.UNSORTED_MAX)")
     args = ap.parse_args(argv)
 
     from jkrdt import rundir

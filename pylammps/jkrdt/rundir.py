@@ -69,7 +69,7 @@ SCENE_FILES = (DATA, META, DECK, *RUN_OUTPUTS, *ANALYSIS_OUTPUTS, *ROLLING_RESTA
 #: the last bits; without it the two are equal bit for bit. At this size sorting gains
 #: nothing (2 x 1000: bins 2.1x faster than nsq either way); at 2 x 25000 it makes the
 #: loop 1.7-2x faster, so larger scenes sort and their continued runs agree as ensembles
-SORT_MIN = 2000
+UNSORTED_MAX = 2000
 
 #: the deck's last line, printed after the last frames and final.restart
 FINISH_LINE = "jkr/dt: run finished step"
@@ -158,7 +158,7 @@ def time_variables(scene: Scene, dt_over_tc: float | None = None) -> dict:
 
 def deck_variables(scene: Scene) -> dict:
     """The variables of ``inputs/collision.lmp`` that make it run ``scene``."""
-    few = scene.n_tar + scene.n_pro <= SORT_MIN
+    few = scene.n_tar + scene.n_pro <= UNSORTED_MAX
     return dict(file=DATA, dim=scene.dim, coeffs=scene.pair_coeff, **time_variables(scene),
                 **(dict(sort="0 0.0") if few else {}))
 
