@@ -23,10 +23,11 @@ max |dE| / E_imp <= 1e-3 (TOLERANCE): the trade study (benchmarks/tradeoff) foun
 outcome moving beyond its scatter up to 0.2 t_c, where the worst run's error was 6.5e-3.
 
 Writes RESULTS (default validation/vfra_size/), from every finished run below RUNS
-whichever call ran it and every run the committed RESULTS/runs.csv already lists: runs.csv (every run, with its loop time), summary.json (per size
-and model: <f_gro> against v_col, v_fra with its bracket, the compute spent; the trend of
-v_fra against N; the paper-size collisions), fig_vfra_size and fig_growth_size
-(<f_gro> against v_col per model, a line per size).
+whichever call ran it and every run the committed RESULTS/runs.csv already lists:
+runs.csv (every run, with its loop time), summary.json (per size and model: <f_gro>
+against v_col, v_fra with its bracket, the compute spent; the trend of v_fra against N;
+the paper-size collisions), fig_vfra_size and fig_growth_size (<f_gro> against v_col per
+model, a line per size).
 
     ./run validate vfra_size                    # 2 x 5000, 2 ranks: 100 runs, hours of both cores
     ./run validate vfra_size --models "frictional, T_vis 6 ps"
@@ -461,8 +462,9 @@ def main(argv=None) -> int:
                 sizes.setdefault(str(n), {})[model] = size_summary(mine, model)
             elif mine:
                 under_way.setdefault(str(n), {})[model] = mine
-    large = [r for model in PAPER_SIZE["speeds"] for r in
-             finished(model_home(runs, PAPER_SIZE["n"], model), PAPER_SIZE["n"], model, ledger)]
+    big = PAPER_SIZE["n"]
+    large = [r for model in PAPER_SIZE["speeds"]
+             for r in finished(model_home(runs, big, model), big, model, ledger)]
     write_csv(results / "runs.csv", rows + [r for m in under_way.values() for x in m.values()
                                             for r in x] + large)
     # the size trend: the committed smaller sizes of bpca3d_models with these (not in the
