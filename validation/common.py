@@ -48,6 +48,19 @@ def loop_seconds(run: Path) -> float:
                re.finditer(r"Loop time of ([0-9.eE+-]+)", (run / LOG).read_text()))
 
 
+def read_committed(results: Path, ints: tuple[str, ...]) -> list[dict]:
+    """The rows of a study's committed ``results/runs.csv``, the columns ``ints`` as whole
+    numbers (none if there is no such file yet): what earlier calls, on this machine or
+    another, finished."""
+    from jkrdt.analysis.tables import read_csv
+
+    path = results / "runs.csv"
+    if not path.exists():
+        return []
+    return [{k: int(v) if k in ints and v != "" else v for k, v in r.items()}
+            for r in read_csv(path)]
+
+
 def campaign_paths(specs: dict[str, dict], runs: Path) -> dict[str, Path]:
     """The directory of each spec's campaign below ``runs`` (its spec beside it, .json)."""
     return {name: runs / re.sub(r"[^A-Za-z0-9.]+", "_", name) for name in specs}

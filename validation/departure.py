@@ -32,9 +32,10 @@ from pathlib import Path
 
 import numpy as np
 
-from common import campaign_paths, loop_seconds, mean_se, run_campaigns, within_scatter
+from common import (campaign_paths, loop_seconds, mean_se, read_committed, run_campaigns,
+                    within_scatter)
 from jkrdt.analysis import dumps, fragments
-from jkrdt.analysis.tables import read_csv, write_csv
+from jkrdt.analysis.tables import write_csv
 from jkrdt import rundir
 from jkrdt.rundir import CONTACTS, LOG, META
 
@@ -137,9 +138,7 @@ def main(argv=None) -> dict:
     if not args.summarise:
         run_campaigns({k: v for k, v in specs.items() if k.split()[0] in run_models},
                       args.runs, args.ranks)
-    committed = args.results / "runs.csv"
-    carried = [{k: int(v) if k in COUNTS and v != "" else v for k, v in r.items()}
-               for r in (read_csv(committed) if committed.exists() else [])]
+    carried = read_committed(args.results, COUNTS)
     rows = []
     for name, path in where.items():
         model, _, depart = name.split()

@@ -52,8 +52,8 @@ from pathlib import Path
 import numpy as np
 
 from bpca3d_models import FULL as SMALLER_PLAN, MODELS, model_spec
-from common import (HERE, campaign_paths, campaign_study_parser, loop_seconds, run_campaigns,
-                    save, study_paths)
+from common import (HERE, campaign_paths, campaign_study_parser, loop_seconds, read_committed,
+                    run_campaigns, save, study_paths)
 from jkrdt import rundir
 from jkrdt.analysis.summary import b_off_mean, threshold_velocity
 from jkrdt.analysis.tables import read_csv, write_csv
@@ -162,15 +162,6 @@ def row_key(r: dict) -> tuple:
     """What tells one run of the study from another: size, model, seed, v_col, B_off^2."""
     return (int(r["size"]), r["model"], int(r["seed"]), round(float(r["v_col"]), 4),
             round(float(r["B_off"]) ** 2, 4))
-
-
-def read_ledger(results: Path) -> list[dict]:
-    """The runs the committed ``results/runs.csv`` lists (none if there is none yet)."""
-    path = results / "runs.csv"
-    if not path.exists():
-        return []
-    return [{k: int(v) if k in INTS and v != "" else v for k, v in r.items()}
-            for r in read_csv(path)]
 
 
 def finished(home: Path, n: int, model: str, ledger: list[dict], seed: int | None = None,
@@ -440,7 +431,7 @@ def main(argv=None) -> int:
     if args.paper_size is not None and not set(args.paper_size) <= set(PAPER_SIZE["b_off2"]):
         p.error(f"--paper-size takes B_off^2 of {PAPER_SIZE['b_off2']}")
     runs, results = study_paths(args, "vfra_size")
-    ledger = read_ledger(results)
+    ledger = read_committed(results, INTS)
     t0 = time.time()
     if args.paper_size is not None:
         run_paper_size(runs, args.np, args.paper_size or PAPER_SIZE["b_off2"], ledger)
