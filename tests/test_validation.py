@@ -20,10 +20,11 @@ from jkrdt.materials import ICE, scales
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def run_quick(study: str, where: Path) -> Path:
+def run_quick(study: str, where: Path, *options: str) -> Path:
     """``validation/<study>.py --quick`` with its runs and results below ``where``."""
     subprocess.run([sys.executable, str(ROOT / "validation" / f"{study}.py"), "--quick",
-                    "--runs", str(where / "runs"), "--results", str(where / "results")],
+                    "--runs", str(where / "runs"), "--results", str(where / "results"),
+                    *options],
                    check=True, timeout=900, capture_output=True)
     return where / "results"
 
@@ -201,6 +202,13 @@ def test_the_size_study_places_v_fra_and_runs_seed_2_where_it_lies(tmp_path):
     assert not (tmp_path / "runs").exists()
     assert (results / "runs.csv").read_text() == table
     assert json.loads((results / "summary.json").read_text())["sizes"] == summary["sizes"]
+    # --summary-only runs nothing: with one run taken out of the ledger (as if it had not
+    # finished yet), the table lacks just that run and no run directory appears
+    lines = table.splitlines(keepends=True)
+    (results / "runs.csv").write_text("".join(lines[:-1]))
+    run_quick("vfra_size", tmp_path, "--summary-only")
+    assert not (tmp_path / "runs").exists()
+    assert (results / "runs.csv").read_text() == "".join(lines[:-1])
 
 
 def test_the_damped_dt_study_compares_two_steps_whose_ledgers_close(tmp_path):

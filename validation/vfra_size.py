@@ -34,11 +34,14 @@ model, a line per size).
     ./run validate vfra_size --paper-size 0 0.5  # 2 x 50000: B_off^2 0 and 6/12 of PAPER_SIZE
     ./run validate vfra_size --sizes 10000
     ./run validate vfra_size --quick            # 2 x 24 grains, two models (tests)
+    ./run validate vfra_size --summary-only     # run nothing: the results of what finished
 
 The committed runs.csv is the study's ledger: a campaign whose every run it lists is not
 run again, and its rows stay in the results, so a machine that lost RUNS (a new checkout,
 a wiped disk) goes on where the last committed results stopped instead of redoing hours of
 runs; of a campaign that the ledger holds in part, only the speeds it lacks run again.
+``--summary-only`` writes the results from the finished runs and runs nothing: the
+finished part of a campaign still under way, to commit while the rest goes on.
 """
 
 from __future__ import annotations
@@ -421,6 +424,8 @@ def main(argv=None) -> int:
     p.add_argument("--paper-size", nargs="*", type=float, default=None, metavar="B_OFF2",
                    help="run the 12 collisions at 2 x 50000 (PAPER_SIZE) instead of the "
                         "sizes, at these B_off^2 (default all four)")
+    p.add_argument("--summary-only", action="store_true",
+                   help="run nothing; write the results from the runs finished so far")
     args = p.parse_args(argv)
     plan = dict(QUICK if args.quick else FULL)
     if args.sizes:
@@ -433,7 +438,9 @@ def main(argv=None) -> int:
     runs, results = study_paths(args, "vfra_size")
     ledger = read_committed(results, INTS)
     t0 = time.time()
-    if args.paper_size is not None:
+    if args.summary_only:
+        pass
+    elif args.paper_size is not None:
         run_paper_size(runs, args.np, args.paper_size or PAPER_SIZE["b_off2"], ledger)
     else:
         for n in plan["sizes"]:
