@@ -343,7 +343,10 @@ struct ChannelLosses {
    contact without tangential channels needs, in a result small enough to
    stay in registers. delta = r1 + r2 - r, eq. (3); formed: the pair was not
    bonded before this step (delta >= 0); energy: fill U_n. Reads and writes
-   the stored F_D (state[L.fd]) when damped.
+   the stored F_D (state[L.fd]) when damped. y_near: the series root of
+   eq. (4) at d = delta/delta0 (contact_sqrt_radius_series(d - 1)), where the
+   caller has taken it ahead for a block of pairs; it stands for the root
+   where the series does (|d - 1| < SERIES_E_MAX), 0 if not taken.
 ------------------------------------------------------------------------- */
 
 struct NormalResult {
@@ -358,7 +361,8 @@ struct NormalResult {
 [[gnu::always_inline]] inline void normal_step(const ContactConstants &c,
                                                const StateLayout &L, double vn, double delta,
                                                double dt, bool setup, bool formed,
-                                               bool energy, double *state, NormalResult &n)
+                                               bool energy, double *state, NormalResult &n,
+                                               double y_near = 0.0)
 {
   const NormalScales &S = c.S;
   n.f = n.U_n = n.loss_event = n.loss_damping = 0.0;
@@ -374,7 +378,9 @@ struct NormalResult {
     }
     return;
   }
-  const double y = contact_sqrt_radius(delta * c.inv_delta0);    // eq. (4)
+  const double d = delta * c.inv_delta0;
+  const double y = (y_near > 0.0 && std::fabs(d - 1.0) < SERIES_E_MAX)
+      ? y_near : contact_sqrt_radius(d);                              // eq. (4)
   n.f = S.F_c * normal_force_ratio(y);                             // eq. (5)
   if (energy || (formed && !setup)) n.U_n = c.u_unit * normal_potential_ratio(y);    // eq. (6)
   // contact formation (section 2.1): U_n jumps from 0 to U_n(0)
@@ -406,7 +412,7 @@ struct NormalResult {
                                                 const StateLayout &L, const ContactMotion &m,
                                                 double delta, double dt, bool setup,
                                                 bool formed, bool energy, double *state,
-                                                ContactResult &out)
+                                                ContactResult &out, double y_near = 0.0)
 {
   out.M1 = out.M2 = {0.0, 0.0, 0.0};
   for (int ch = 0; ch < NCHANNEL; ch++) out.U[ch] = 0.0;
@@ -415,7 +421,7 @@ struct NormalResult {
     for (int k = 0; k < L.dnum; k++) state[k] = 0.0;
 
   NormalResult n;
-  normal_step(c, L, m.vn, delta, dt, setup, formed, energy, state, n);
+  normal_step(c, L, m.vn, delta, dt, setup, formed, energy, state, n, y_near);
   out.U_n = n.U_n;
   out.loss[LOSS_FORM_BREAK] = n.loss_event;
   out.loss[LOSS_DAMPING] = n.loss_damping;

@@ -204,7 +204,8 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
   const bool run_setup = update->setupflag;
   const double dt = update->dt;
   const double half_skin = 0.5 * neighbor->skin;
-  double **f = atom->f, **tq = atom->torque, **ledger = fix_contacts->ledger;
+  double *const f = atom->f[0], *const tq = atom->torque[0];    // flat, as x
+  double **ledger = fix_contacts->ledger;
   // an owned atom of another thread gets its share through acc.far
   const int *thread_of_atom = acc.thread_of;
   const int me = acc.thread;
@@ -234,28 +235,76 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
     }
     return cached;
   };
+  // the sums of every step, in registers while the loop runs
+  bigint contact_ends = 0;
+  double step_max = acc.step_max;
+  auto hand_over = [&]() {
+    acc.contact_ends += contact_ends;
+    acc.step_max = step_max;
+  };
   auto trouble = [&](Trouble::Kind kind, int p, int q, double a, double b,
                      const JKRDT::ContactConstants &K) {
     if (tag[q] < tag[p]) std::swap(p, q);    // name the pair as the other rank does
     acc.trouble = {kind, p, q, a, b, K.S};
+    hand_over();
   };
   JKRDT::ContactResult out;
 
-  for (int ii = ii_from; ii < ii_to; ii++) {
-    const int i = ilist[ii];
-    const int *jlist = firstneigh[i];
-    const int jnum = numneigh[i];
-    const V3 xi = JKRDT::vec(x + 3 * i);
-    int s = C.slot_first[ii];
-    for (int jj = 0; jj < jnum; jj++, s++) {
-      const int j = jlist[jj] & NEIGHMASK;
+  // 1. the distance test, over a block of the list's pairs at a time: the pairs in
+  // contact or touching are kept with their separation, and their r and 1/r are then
+  // taken for the whole block at once: square roots and divisions that do not wait for
+  // one another, instead of heading each pair's chain of dependent steps
+  constexpr int BLOCK = 64;
+  struct {
+    int i[BLOCK], j[BLOCK], slot[BLOCK];
+    V3 d12[BLOCK];
+    double rsq[BLOCK], radsum[BLOCK], r[BLOCK], rinv[BLOCK], y_near[BLOCK];
+  } B;
+  int ii = ii_from, jj = 0;
+  while (ii < ii_to) {
+    int n = 0;
+    while (ii < ii_to && n < BLOCK) {
+      const int i = ilist[ii];
+      const int *jlist = firstneigh[i];
+      const int jnum = numneigh[i];
+      const V3 xi = JKRDT::vec(x + 3 * i);
+      for (int s = C.slot_first[ii] + jj; jj < jnum && n < BLOCK; jj++, s++) {
+        const int j = jlist[jj] & NEIGHMASK;
+        const V3 d12 = xi - JKRDT::vec(x + 3 * j);
+        const double rsq = JKRDT::dot(d12, d12);
+        const double radsum = by == BY_SCENE ? scene_K->radsum : radius[i] + radius[j];
+        if (!bonded_slot[s] && rsq > radsum * radsum) continue;
+        B.i[n] = i;
+        B.j[n] = j;
+        B.slot[n] = s;
+        B.d12[n] = d12;
+        B.rsq[n] = rsq;
+        B.radsum[n] = radsum;
+        n++;
+      }
+      if (jj == jnum) {
+        ii++;
+        jj = 0;
+      }
+    }
+    for (int k = 0; k < n; k++) B.r[k] = std::sqrt(B.rsq[k]);
+    for (int k = 0; k < n; k++) B.rinv[k] = 1.0 / B.r[k];
+    // and, with one set of constants for the scene, the series root of eq. (4) that a
+    // contact near rest takes (normal_step uses it only there)
+    if (by == BY_SCENE) {
+      const double inv_delta0 = scene_K->inv_delta0;
+      for (int k = 0; k < n; k++)
+        B.y_near[k] = JKRDT::contact_sqrt_radius_series((B.radsum[k] - B.r[k]) * inv_delta0 -
+                                                        1.0);
+    } else {
+      std::fill(B.y_near, B.y_near + n, 0.0);
+    }
 
-      // 1. the distance test
+    for (int k = 0; k < n; k++) {
+      const int i = B.i[k], j = B.j[k], s = B.slot[k];
       const bool bonded = bonded_slot[s];
-      V3 d12 = xi - JKRDT::vec(x + 3 * j);
-      const double rsq = JKRDT::dot(d12, d12);
-      const double radsum = by == BY_SCENE ? scene_K->radsum : radius[i] + radius[j];
-      if (!bonded && rsq > radsum * radsum) continue;
+      V3 d12 = B.d12[k];
+      const double radsum = B.radsum[k];
 
       // 2. orientation (p = particle 1) and constants
       int p = i, q = j;
@@ -270,19 +319,19 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
       const int owned = (p < nlocal) + (q < nlocal);    // a contact counts half per owned atom
       const bool parked = departed && ((mask[p] | mask[q]) & departed);
       if (parked && !(bonded && eflag)) {
-        if (bonded) acc.contact_ends += owned;
+        if (bonded) contact_ends += owned;
         continue;
       }
       const bool setup = run_setup || parked;
 
       // 3. the motion over the step, and the guards that name a pair the step cannot resolve
-      const double r = std::sqrt(rsq);
+      const double r = B.r[k];
       const double delta = radsum - r;    // eq. (3)
       if (!std::isfinite(delta) || r == 0.0) return trouble(Trouble::BLOW_UP, p, q, r, 0.0, K);
       JKRDT::ContactMotion m;
       m.d12 = d12;
       m.r = r;
-      m.rinv = 1.0 / r;
+      m.rinv = B.rinv[k];
       m.v12 = JKRDT::vec(v + 3 * p) - JKRDT::vec(v + 3 * q);
       if (TANGENTIAL) {
         m.w1 = JKRDT::vec(omega + 3 * p);
@@ -291,7 +340,7 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
       m.vn = JKRDT::dot(m.v12, d12) * m.rinv;    // at the half step, > 0 when separating
       const double step = parked ? 0.0 : std::fabs(m.vn) * dt;
       if (step > half_skin) return trouble(Trouble::FAST_PAIR, p, q, m.vn, 0.0, K);
-      if (!setup) acc.step_max = std::max(acc.step_max, step * K.inv_delta_c);
+      if (!setup) step_max = std::max(step_max, step * K.inv_delta_c);
       const bool formed = !bonded;    // delta >= 0 here: contact formation (section 2.1)
       if (formed && setup && delta >= std::min(radius[p], radius[q]))
         return trouble(Trouble::OVERLAP, p, q, delta, 0.0, K);
@@ -308,14 +357,16 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
       JKRDT::NormalResult n;
       double normal_loss[2];
       if (TANGENTIAL) {
-        JKRDT::contact_step(K, layout, m, delta, dt, setup, formed, eflag, state, out);
+        JKRDT::contact_step(K, layout, m, delta, dt, setup, formed, eflag, state, out,
+                            B.y_near[k]);
         fp = out.F1;
         broken = out.broken;
         lossy = out.lossy;
         loss = out.loss;
         U_n = out.U_n;
       } else {
-        JKRDT::normal_step(K, layout, m.vn, delta, dt, setup, formed, eflag, state, n);
+        JKRDT::normal_step(K, layout, m.vn, delta, dt, setup, formed, eflag, state, n,
+                           B.y_near[k]);
         fp = (n.f * m.rinv) * d12;
         broken = n.broken;
         lossy = n.lossy;
@@ -337,8 +388,8 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
           if (a >= nlocal) continue;
           double *fa, *ta, *la;
           if (!thread_of_atom || thread_of_atom[a] == me) {
-            fa = f[a];
-            ta = tq[a];
+            fa = f + 3 * a;
+            ta = tq + 3 * a;
             la = ledger[a];
           } else {
             acc.far.push_back(FarLoad{a, {0, 0, 0}, {0, 0, 0}, {0, 0, 0, 0, 0}});
@@ -363,7 +414,7 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
       if (broken) continue;
 
       // energy and virial
-      acc.contact_ends += owned;
+      contact_ends += owned;
       if (!eflag && !vflag_either) continue;
       const double share = 0.5 * owned;
       const double u = TANGENTIAL ? U_n + out.U[0] + out.U[1] + out.U[2] : U_n;
@@ -388,6 +439,7 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
       }
     }
   }
+  hand_over();
 }
 
 /* ----------------------------------------------------------------------

@@ -31,4 +31,4 @@ def test_contact_kernel_checks(tmp_path):
     lines = run.stdout.splitlines()
     assert lines[-1] == "0 failed", run.stdout
     checks = [line for line in lines[:-1]]
-    assert len(checks) == 28 and all(line.startswith("ok ") for line in checks), run.stdout
+    assert len(checks) == 29 and all(line.startswith("ok ") for line in checks), run.stdout
