@@ -438,11 +438,9 @@ def main(argv=None) -> int:
     runs, results = study_paths(args, "vfra_size")
     ledger = read_committed(results, INTS)
     t0 = time.time()
-    if args.summary_only:
-        pass
-    elif args.paper_size is not None:
+    if args.paper_size is not None and not args.summary_only:
         run_paper_size(runs, args.np, args.paper_size or PAPER_SIZE["b_off2"], ledger)
-    else:
+    elif not args.summary_only:
         for n in plan["sizes"]:
             for model in args.models or plan["grids"]:
                 run_model(model, n, plan, runs, args.np, ledger)
