@@ -181,21 +181,26 @@ inline void swap_particles(double *values, const StateLayout &L)
   }
 }
 
-// the stored tangential state; false if the pointers were never set (a
-// contact formed while no channel needed them)
+// the contact's pointers were set (false for a contact formed while no channel needed them)
+inline bool traced(const double *values, const StateLayout &L)
+{
+  if (L.pointers < 0) return true;
+  const V3 n1 = vec(values + L.pointers);
+  return dot(n1, n1) > 0.0;
+}
+
+// the stored tangential state; false if the pointers were never set
 inline bool load_state(const double *values, const StateLayout &L, ContactState &c)
 {
   c.n1 = {0.0, 0.0, 0.0};
   c.n2 = c.n1;
   c.phi = 0.0;
-  bool set = true;
   if (L.pointers >= 0) {
     c.n1 = vec(values + L.pointers);
     c.n2 = vec(values + L.pointers + 3);
-    set = dot(c.n1, c.n1) > 0.0;
   }
   if (L.phi >= 0) c.phi = values[L.phi];
-  return set;
+  return traced(values, L);
 }
 
 inline void store_state(double *values, const StateLayout &L, const ContactState &c)
@@ -281,6 +286,22 @@ struct ChannelLosses {
 }
 
 /* ----------------------------------------------------------------------
+   eq. (24) over one step: the increment (omega1 - omega2) . n_c dt of phi,
+   n_c at the half step: (d12 - h) / |d12 - h| with h = (v1 - v2) dt/2, to
+   first order in h / r (the error, (h / r)^2 of one increment, is third
+   order in dt). One contact, or a lane of contacts (V3T)
+------------------------------------------------------------------------- */
+
+template <class T>
+inline T twist_increment(const V3T<T> &d12, const V3T<T> &v12, const V3T<T> &w1,
+                         const V3T<T> &w2, const T &rinv, const V3T<T> &nc, double dt)
+{
+  const V3T<T> h = (0.5 * dt) * v12;
+  const V3T<T> nc_half = ((1.0 + dot(nc, h) * rinv) * rinv) * (d12 - h);
+  return dt * dot(w1 - w2, nc_half);
+}
+
+/* ----------------------------------------------------------------------
    the tangential channels over one step (section 2.2); adds their loads
    to the result, books clamps and, for a contact that breaks, the springs'
    energy
@@ -303,14 +324,7 @@ struct ChannelLosses {
     now = {-nc, nc, 0.0};    // section 2.2.4: n1(t0) = -n_c(t0), n2 = n_c
   } else if (!setup) {
     turned(now.n1, dt * m.w1, now.n2, dt * m.w2);
-    if (K.twisting) {
-      // eq. (24): phi += (omega1 - omega2) . n_c dt, n_c at the half step:
-      // (d12 - h) / |d12 - h| with h = (v1 - v2) dt/2, to first order in h / r
-      // (the error, (h / r)^2 of one increment, is third order in dt)
-      const V3 h = (0.5 * dt) * m.v12;
-      const V3 nc_half = ((1.0 + dot(nc, h) * m.rinv) * m.rinv) * (m.d12 - h);
-      now.phi += dt * dot(m.w1 - m.w2, nc_half);
-    }
+    if (K.twisting) now.phi += twist_increment(m.d12, m.v12, m.w1, m.w2, m.rinv, nc, dt);
   }
 
   // a set-up evaluates the stored state as it is: the clamp of eqs. (42), (A8) is exact
@@ -336,6 +350,43 @@ struct ChannelLosses {
   store_state(state, L, now);
   add_tangential_loads(now, d, nc, m.rinv, c.r1, c.r2, R, K, energy, out.F1, out.M1, out.M2,
                        out.U);                                           // eqs. (14)-(27)
+}
+
+/* ----------------------------------------------------------------------
+   the tangential step of tangential_step() on its common path, for a lane
+   of contacts at once (T = Lanes4, one contact per lane, one set of
+   constants): a traced contact, not a set-up, not breaking, whose pointers
+   turn by the series and whose displacements stay within their limits. It
+   is made of the same functions as tangential_step(), so each lane has the
+   bits that tangential_step() gives its contact. s: the stored state in,
+   the state after the step out; adds the loads to F1, M1, M2 and (energy)
+   the potentials to U. Returns the lanes that stayed on the common path;
+   the others' results are not valid (their contacts take
+   tangential_step(), which clamps and books).
+------------------------------------------------------------------------- */
+
+template <class T>
+inline auto tangential_common_step(const ContactConstants &c, const V3T<T> &d12,
+                                   const V3T<T> &v12, const V3T<T> &w1, const V3T<T> &w2,
+                                   const T &rinv, double dt, bool energy, ContactStateT<T> &s,
+                                   V3T<T> &F1, V3T<T> &M1, V3T<T> &M2, T U[NCHANNEL])
+{
+  const Tangential &K = c.K;
+  const double R = c.S.R;
+  const V3T<T> nc = rinv * d12;    // eq. (9)
+  const V3T<T> w1dt = dt * w1, w2dt = dt * w2;
+  const T t1 = dot(w1dt, w1dt), t2 = dot(w2dt, w2dt);
+  auto on = (t1 < TURN_SERIES_T2) & (t2 < TURN_SERIES_T2);
+  s.n1 = turned_series(s.n1, w1dt, t1);    // section 2.2.4
+  s.n2 = turned_series(s.n2, w2dt, t2);
+  if (K.twisting) s.phi = s.phi + twist_increment(d12, v12, w1, w2, rinv, nc, dt);
+  const DisplacementsT<T> d = displacements(s, nc, c.r1, c.r2, R);    // eqs. (8)-(20)
+  // within the elastic limits (the clamps of eqs. 42, A8 would not act)
+  if (K.sliding) on &= dot(d.zeta, d.zeta) <= K.zeta_crit * K.zeta_crit;
+  if (K.rolling) on &= dot(d.xi, d.xi) <= K.xi_crit * K.xi_crit;
+  if (K.twisting) on &= (s.phi <= K.phi_crit) & (s.phi >= -K.phi_crit);
+  add_tangential_loads(s, d, nc, rinv, c.r1, c.r2, R, K, energy, F1, M1, M2, U);
+  return on;
 }
 
 /* ----------------------------------------------------------------------
@@ -406,13 +457,17 @@ struct NormalResult {
    channels. delta = r1 + r2 - r, eq. (3); formed: the pair was not bonded
    before this step (delta >= 0); energy: fill U_n and U.
    The state (L.dnum values) is read and written in place.
+   contact_normal_part() is its first half, which the pair loop also calls
+   alone for a contact whose tangential step it takes in a lane
+   (jkr_dt_lanes.h); it returns whether the contact broke.
 ------------------------------------------------------------------------- */
 
-[[gnu::always_inline]] inline void contact_step(const ContactConstants &c,
-                                                const StateLayout &L, const ContactMotion &m,
-                                                double delta, double dt, bool setup,
-                                                bool formed, bool energy, double *state,
-                                                ContactResult &out, double y_near = 0.0)
+[[gnu::always_inline]] inline bool contact_normal_part(const ContactConstants &c,
+                                                       const StateLayout &L,
+                                                       const ContactMotion &m, double delta,
+                                                       double dt, bool setup, bool formed,
+                                                       bool energy, double *state,
+                                                       ContactResult &out, double y_near = 0.0)
 {
   out.M1 = out.M2 = {0.0, 0.0, 0.0};
   for (int ch = 0; ch < NCHANNEL; ch++) out.U[ch] = 0.0;
@@ -428,7 +483,18 @@ struct NormalResult {
   out.lossy = n.lossy;
   out.broken = n.broken;
   out.F1 = n.broken ? V3{0.0, 0.0, 0.0} : (n.f * m.rinv) * m.d12;
-  if (c.tangential) tangential_step(c, L, m, dt, setup, formed, n.broken, energy, state, out);
+  return n.broken;
+}
+
+[[gnu::always_inline]] inline void contact_step(const ContactConstants &c,
+                                                const StateLayout &L, const ContactMotion &m,
+                                                double delta, double dt, bool setup,
+                                                bool formed, bool energy, double *state,
+                                                ContactResult &out, double y_near = 0.0)
+{
+  const bool broken =
+      contact_normal_part(c, L, m, delta, dt, setup, formed, energy, state, out, y_near);
+  if (c.tangential) tangential_step(c, L, m, dt, setup, formed, broken, energy, state, out);
 }
 
 }    // namespace JKRDT

@@ -29,23 +29,43 @@ namespace JKRDT {
    three-vectors
 ------------------------------------------------------------------------ */
 
-struct V3 {
-  double x, y, z;
+// one 3-vector, or (T a vector of doubles) the same 3-vector of several contacts, one per
+// lane: the functions below that take V3T<T> do the same arithmetic in every lane, so a
+// lane's result has the bits of the same function called on that contact alone
+template <class T> struct V3T {
+  T x, y, z;
 };
+using V3 = V3T<double>;
 
 inline V3 vec(const double *a) { return {a[0], a[1], a[2]}; }
 inline void store(const V3 &a, double *out) { out[0] = a.x; out[1] = a.y; out[2] = a.z; }
-inline V3 operator+(const V3 &a, const V3 &b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline V3 operator-(const V3 &a, const V3 &b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline V3 operator-(const V3 &a) { return {-a.x, -a.y, -a.z}; }
-inline V3 operator*(double s, const V3 &a) { return {s * a.x, s * a.y, s * a.z}; }
-inline double dot(const V3 &a, const V3 &b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+template <class T> inline V3T<T> operator+(const V3T<T> &a, const V3T<T> &b)
+{
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+template <class T> inline V3T<T> operator-(const V3T<T> &a, const V3T<T> &b)
+{
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+template <class T> inline V3T<T> operator-(const V3T<T> &a) { return {-a.x, -a.y, -a.z}; }
+template <class S, class T> inline V3T<T> operator*(const S &s, const V3T<T> &a)
+{
+  return {s * a.x, s * a.y, s * a.z};
+}
+template <class T> inline T dot(const V3T<T> &a, const V3T<T> &b)
+{
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 inline double norm(const V3 &a) { return std::sqrt(dot(a, a)); }
-inline V3 cross(const V3 &a, const V3 &b)
+template <class T> inline V3T<T> cross(const V3T<T> &a, const V3T<T> &b)
 {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 inline V3 unit(const V3 &a) { return (1.0 / norm(a)) * a; }
+
+// lanes of two (any x86-64: SSE2) and of four doubles (AVX2, or two SSE2 halves)
+typedef double Lanes __attribute__((vector_size(16)));
+typedef double Lanes4 __attribute__((vector_size(32)));
 
 /* ---------------------------------------------------------------------
    tracing of the contact pointers, section 2.2.4
@@ -77,49 +97,45 @@ template <class T> inline T turn_series_b(const T &t2)
   return 0.5 - t2 * (1.0 / 24.0) * (1.0 - t2 * (1.0 / 30.0) * (1.0 - t2 * (1.0 / 56.0)));
 }
 
-inline V3 turned(const V3 &n, const V3 &w)
+// n + a (w x n) + b w (w . n) - b t^2 n, renormalized: the rotation of n by w, given a, b
+template <class T>
+inline V3T<T> rodrigues(const V3T<T> &n, const V3T<T> &w, const T &t2, const T &a, const T &b)
 {
-  const double t2 = dot(w, w);
-  double a, b;
-  if (t2 < 1.0e-4) {
-    a = turn_series_a(t2);
-    b = turn_series_b(t2);
-  } else {
-    const double t = std::sqrt(t2);
-    a = std::sin(t) / t;
-    b = (1.0 - std::cos(t)) / t2;
-  }
-  const V3 r = (1.0 - b * t2) * n + a * cross(w, n) + (b * dot(w, n)) * w;
+  const V3T<T> r = (1.0 - b * t2) * n + a * cross(w, n) + (b * dot(w, n)) * w;
   return (1.5 - 0.5 * dot(r, r)) * r;
 }
 
-// the two pointers of a contact turned at once, n1 by w1 and n2 by w2: the same
-// arithmetic as turned(), one lane per particle (GCC/Clang vector extensions; SSE2 on
-// any x86-64), so the result equals two calls of turned() bit for bit
-typedef double Lanes __attribute__((vector_size(16)));
-struct V3x2 {
-  Lanes x, y, z;    // lane 0: particle 1, lane 1: particle 2
-};
+// the turn by the series: for |w|^2 < TURN_SERIES_T2 in every lane
+constexpr double TURN_SERIES_T2 = 1.0e-4;
+template <class T> inline V3T<T> turned_series(const V3T<T> &n, const V3T<T> &w, const T &t2)
+{
+  return rodrigues(n, w, t2, turn_series_a(t2), turn_series_b(t2));
+}
+
+inline V3 turned(const V3 &n, const V3 &w)
+{
+  const double t2 = dot(w, w);
+  if (t2 < TURN_SERIES_T2) return turned_series(n, w, t2);
+  const double t = std::sqrt(t2);
+  return rodrigues(n, w, t2, std::sin(t) / t, (1.0 - std::cos(t)) / t2);
+}
+
+// the two pointers of a contact turned at once, n1 by w1 and n2 by w2, one lane per
+// particle, so the result equals two calls of turned() bit for bit
+using V3x2 = V3T<Lanes>;
 inline V3x2 lanes(const V3 &a, const V3 &b) { return {Lanes{a.x, b.x}, Lanes{a.y, b.y}, Lanes{a.z, b.z}}; }
 inline V3 lane(const V3x2 &p, int k) { return {p.x[k], p.y[k], p.z[k]}; }
-inline Lanes dot(const V3x2 &a, const V3x2 &b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 
 inline void turned(V3 &n1, const V3 &w1, V3 &n2, const V3 &w2)
 {
   const V3x2 n = lanes(n1, n2), w = lanes(w1, w2);
   const Lanes t2 = dot(w, w);
-  if (!(t2[0] < 1.0e-4 && t2[1] < 1.0e-4)) {
+  if (!(t2[0] < TURN_SERIES_T2 && t2[1] < TURN_SERIES_T2)) {
     n1 = turned(n1, w1);
     n2 = turned(n2, w2);
     return;
   }
-  const Lanes a = turn_series_a(t2), b = turn_series_b(t2);
-  const V3x2 wn = {w.y * n.z - w.z * n.y, w.z * n.x - w.x * n.z, w.x * n.y - w.y * n.x};
-  const Lanes c = 1.0 - b * t2, e = b * dot(w, n);
-  const V3x2 r = {c * n.x + a * wn.x + e * w.x, c * n.y + a * wn.y + e * w.y,
-                  c * n.z + a * wn.z + e * w.z};
-  const Lanes g = 1.5 - 0.5 * dot(r, r);
-  const V3x2 out = {g * r.x, g * r.y, g * r.z};
+  const V3x2 out = turned_series(n, w, t2);
   n1 = lane(out, 0);
   n2 = lane(out, 1);
 }
@@ -143,34 +159,44 @@ inline double phi_crit() { return PHI_CRIT; }
    displacements, eqs. (8)-(10) and (20)
 ------------------------------------------------------------------------ */
 
-struct ContactState {
-  V3 n1, n2;     // contact pointers
-  double phi;    // twisting angle along n_c, eq. (24)
+template <class T> struct ContactStateT {
+  V3T<T> n1, n2;    // contact pointers
+  T phi;            // twisting angle along n_c, eq. (24)
 };
+using ContactState = ContactStateT<double>;
 
 // zeta_0, eq. (8)
-inline V3 sliding_zeta0(const ContactState &c, const V3 &nc, double r1, double r2)
+template <class T>
+inline V3T<T> sliding_zeta0(const ContactStateT<T> &c, const V3T<T> &nc, double r1, double r2)
 {
   return r1 * c.n1 - r2 * c.n2 + (r1 + r2) * nc;
 }
 
 // zeta, the part of zeta_0 normal to n_c, eq. (10)
-inline V3 tangential_part(const V3 &a, const V3 &nc) { return a - dot(a, nc) * nc; }
+template <class T> inline V3T<T> tangential_part(const V3T<T> &a, const V3T<T> &nc)
+{
+  return a - dot(a, nc) * nc;
+}
 
 // xi = R (n1 + n2), eq. (20)
-inline V3 rolling_xi(const ContactState &c, double R) { return R * (c.n1 + c.n2); }
+template <class T> inline V3T<T> rolling_xi(const ContactStateT<T> &c, double R)
+{
+  return R * (c.n1 + c.n2);
+}
 
 // the displacements a state's loads and limits are made of, computed once per step
-struct Displacements {
-  V3 zeta0;    // eq. (8)
-  V3 zeta;     // eq. (10)
-  V3 xi;       // eq. (20)
+template <class T> struct DisplacementsT {
+  V3T<T> zeta0;    // eq. (8)
+  V3T<T> zeta;     // eq. (10)
+  V3T<T> xi;       // eq. (20)
 };
+using Displacements = DisplacementsT<double>;
 
-inline Displacements displacements(const ContactState &c, const V3 &nc, double r1, double r2,
-                                   double R)
+template <class T>
+inline DisplacementsT<T> displacements(const ContactStateT<T> &c, const V3T<T> &nc, double r1,
+                                       double r2, double R)
 {
-  Displacements d;
+  DisplacementsT<T> d;
   d.zeta0 = sliding_zeta0(c, nc, r1, r2);
   d.zeta = tangential_part(d.zeta0, nc);
   d.xi = rolling_xi(c, R);
@@ -232,37 +258,36 @@ inline void tangential_load(const ContactState &c, const V3 &nc, double rinv, do
 }
 
 // the channels' loads summed, as a step that books nothing needs them: the same
-// eqs. (14)-(27), with the torques on both particles in one pass (lane k: particle k + 1),
-// since every torque of eqs. (17) and (23) is its pointer crossed with a displacement:
+// eqs. (14)-(27); every torque of eqs. (17) and (23) is its pointer crossed with a
+// displacement, so each particle's takes one cross product:
 //   M1 = n1 x (-r1 k_s zeta - R k_r xi) - k_t phi n_c
 //   M2 = n2 x ( r2 k_s zeta - R k_r xi) + k_t phi n_c
 // adds to F1, M1, M2; the potentials go to U only if energy is asked for
-inline void add_tangential_loads(const ContactState &c, const Displacements &d, const V3 &nc,
-                                 double rinv, double r1, double r2, double R,
-                                 const Tangential &K, bool energy, V3 &F1, V3 &M1, V3 &M2,
-                                 double U[NCHANNEL])
+template <class T>
+inline void add_tangential_loads(const ContactStateT<T> &c, const DisplacementsT<T> &d,
+                                 const V3T<T> &nc, const T &rinv, double r1, double r2,
+                                 double R, const Tangential &K, bool energy, V3T<T> &F1,
+                                 V3T<T> &M1, V3T<T> &M2, T U[NCHANNEL])
 {
-  V3x2 arm = {Lanes{0.0, 0.0}, Lanes{0.0, 0.0}, Lanes{0.0, 0.0}};
+  V3T<T> arm1 = {T{}, T{}, T{}}, arm2 = arm1;
   if (K.sliding) {
     F1 = F1 + (-K.k_s * (r1 + r2 - dot(d.zeta0, nc)) * rinv) * d.zeta;   // eq. (14)
-    const Lanes k = {-r1 * K.k_s, r2 * K.k_s};                           // eq. (17)
-    arm = {k * d.zeta.x, k * d.zeta.y, k * d.zeta.z};
+    arm1 = (-r1 * K.k_s) * d.zeta;                                       // eq. (17)
+    arm2 = (r2 * K.k_s) * d.zeta;
     if (energy) U[SLIDE] = 0.5 * K.k_s * dot(d.zeta, d.zeta);             // eq. (11)
   }
   if (K.rolling) {
     const double k = -R * K.k_r;                                         // eq. (23)
-    arm = {arm.x + k * d.xi.x, arm.y + k * d.xi.y, arm.z + k * d.xi.z};
+    arm1 = arm1 + k * d.xi;
+    arm2 = arm2 + k * d.xi;
     if (energy) U[ROLL] = 0.5 * K.k_r * dot(d.xi, d.xi);                  // eq. (21)
   }
   if (K.sliding || K.rolling) {
-    const V3x2 n = lanes(c.n1, c.n2);
-    const V3x2 m = {n.y * arm.z - n.z * arm.y, n.z * arm.x - n.x * arm.z,
-                    n.x * arm.y - n.y * arm.x};
-    M1 = M1 + lane(m, 0);
-    M2 = M2 + lane(m, 1);
+    M1 = M1 + cross(c.n1, arm1);
+    M2 = M2 + cross(c.n2, arm2);
   }
   if (K.twisting) {
-    const V3 twist = (-K.k_t * c.phi) * nc;                              // eq. (27)
+    const V3T<T> twist = (-K.k_t * c.phi) * nc;                          // eq. (27)
     M1 = M1 + twist;
     M2 = M2 - twist;
     if (energy) U[TWIST] = 0.5 * K.k_t * c.phi * c.phi;                   // eq. (25)

@@ -32,6 +32,7 @@
 #include "pair_jkr_dt.h"
 
 #include "fix_jkr_dt_contacts.h"
+#include "jkr_dt_lanes.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -248,7 +249,19 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
     acc.trouble = {kind, p, q, a, b, K.S};
     hand_over();
   };
-  JKRDT::ContactResult out;
+  // a pair of the block: where evaluate() leaves it for deliver()
+  enum class Eval { SKIP, DONE, TROUBLE };
+  struct Done {
+    int p, q, s, owned;
+    bool parked, setup;
+    V3 d12;
+    double *state;
+    JKRDT::ContactMotion m;
+    JKRDT::ContactResult out;
+  };
+  // the lanes' path: the tangential step four contacts at a time (jkr_dt_lanes.h), for
+  // one set of constants and contacts that store their pointers
+  const bool lanes = TANGENTIAL && by == BY_SCENE && scene_K->tangential && layout.pointers >= 0;
 
   // 1. the distance test, over a block of the list's pairs at a time: the pairs in
   // contact or touching are kept with their separation, and their r and 1/r are then
@@ -259,7 +272,10 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
     int i[BLOCK], j[BLOCK], slot[BLOCK];
     V3 d12[BLOCK];
     double rsq[BLOCK], radsum[BLOCK], r[BLOCK], rinv[BLOCK], y_near[BLOCK];
+    Eval eval[BLOCK];
+    Done done[BLOCK];
   } B;
+  JKRDT::TangentialLanes<BLOCK> TL;
   int ii = ii_from, jj = 0;
   while (ii < ii_to) {
     int n = 0;
@@ -300,7 +316,12 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
       std::fill(B.y_near, B.y_near + n, 0.0);
     }
 
-    for (int k = 0; k < n; k++) {
+    // 2.-4. each pair's contact over the step (evaluate); 5. its loads delivered (deliver).
+    // On the lanes' path (below) the tangential step of the contacts on its common path
+    // is taken four at a time in between, and every pair of the block is delivered after
+    // it, in list order, as without it
+    int nlane = 0;
+    auto evaluate = [&](int k, Done &o) -> Eval {
       const int i = B.i[k], j = B.j[k], s = B.slot[k];
       const bool bonded = bonded_slot[s];
       V3 d12 = B.d12[k];
@@ -320,15 +341,25 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
       const bool parked = departed && ((mask[p] | mask[q]) & departed);
       if (parked && !(bonded && eflag)) {
         if (bonded) contact_ends += owned;
-        continue;
+        return Eval::SKIP;
       }
       const bool setup = run_setup || parked;
+      o.p = p;
+      o.q = q;
+      o.s = s;
+      o.owned = owned;
+      o.parked = parked;
+      o.setup = setup;
+      o.d12 = d12;
 
       // 3. the motion over the step, and the guards that name a pair the step cannot resolve
       const double r = B.r[k];
       const double delta = radsum - r;    // eq. (3)
-      if (!std::isfinite(delta) || r == 0.0) return trouble(Trouble::BLOW_UP, p, q, r, 0.0, K);
-      JKRDT::ContactMotion m;
+      if (!std::isfinite(delta) || r == 0.0) {
+        trouble(Trouble::BLOW_UP, p, q, r, 0.0, K);
+        return Eval::TROUBLE;
+      }
+      JKRDT::ContactMotion &m = o.m;
       m.d12 = d12;
       m.r = r;
       m.rinv = B.rinv[k];
@@ -339,50 +370,69 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
       }
       m.vn = JKRDT::dot(m.v12, d12) * m.rinv;    // at the half step, > 0 when separating
       const double step = parked ? 0.0 : std::fabs(m.vn) * dt;
-      if (step > half_skin) return trouble(Trouble::FAST_PAIR, p, q, m.vn, 0.0, K);
+      if (step > half_skin) {
+        trouble(Trouble::FAST_PAIR, p, q, m.vn, 0.0, K);
+        return Eval::TROUBLE;
+      }
       if (!setup) step_max = std::max(step_max, step * K.inv_delta_c);
       const bool formed = !bonded;    // delta >= 0 here: contact formation (section 2.1)
-      if (formed && setup && delta >= std::min(radius[p], radius[q]))
-        return trouble(Trouble::OVERLAP, p, q, delta, 0.0, K);
+      if (formed && setup && delta >= std::min(radius[p], radius[q])) {
+        trouble(Trouble::OVERLAP, p, q, delta, 0.0, K);
+        return Eval::TROUBLE;
+      }
       // a contact forms within the step that closes the gap: deeper means it was missed
-      if (formed && !setup && delta > 2.0 * step + LATE_SLACK * K.S.delta_c)
-        return trouble(Trouble::LATE, p, q, delta, step, K);
+      if (formed && !setup && delta > 2.0 * step + LATE_SLACK * K.S.delta_c) {
+        trouble(Trouble::LATE, p, q, delta, step, K);
+        return Eval::TROUBLE;
+      }
 
-      // 4. the contact over the step: the whole kernel, or its normal part alone
+      // 4. the contact over the step: the whole kernel, or its normal part alone, or (the
+      // lanes' path) the normal part now and the tangential step in a lane
       double *state = layout.dnum ? slot_values + (bigint) s * layout.dnum : nullptr;
-      V3 fp;
-      bool broken, lossy;
-      const double *loss;
-      double U_n;
-      JKRDT::NormalResult n;
-      double normal_loss[2];
-      if (TANGENTIAL) {
+      o.state = state;
+      JKRDT::ContactResult &out = o.out;
+      if constexpr (!TANGENTIAL) {
+        JKRDT::NormalResult nr;
+        JKRDT::normal_step(K, layout, m.vn, delta, dt, setup, formed, eflag, state, nr,
+                           B.y_near[k]);
+        out.F1 = (nr.f * m.rinv) * d12;
+        out.broken = nr.broken;
+        out.lossy = nr.lossy;
+        out.loss[JKRDT::LOSS_FORM_BREAK] = nr.loss_event;
+        out.loss[JKRDT::LOSS_DAMPING] = nr.loss_damping;
+        out.U_n = nr.U_n;
+        return Eval::DONE;
+      }
+      // a lane takes a traced contact's step that is no set-up and does not break
+      const bool in_lane = lanes && !setup && !formed && !(delta < -K.S.delta_c) &&
+          JKRDT::traced(state, layout);
+      if (!in_lane) {
         JKRDT::contact_step(K, layout, m, delta, dt, setup, formed, eflag, state, out,
                             B.y_near[k]);
-        fp = out.F1;
-        broken = out.broken;
-        lossy = out.lossy;
-        loss = out.loss;
-        U_n = out.U_n;
-      } else {
-        JKRDT::normal_step(K, layout, m.vn, delta, dt, setup, formed, eflag, state, n,
-                           B.y_near[k]);
-        fp = (n.f * m.rinv) * d12;
-        broken = n.broken;
-        lossy = n.lossy;
-        normal_loss[JKRDT::LOSS_FORM_BREAK] = n.loss_event;
-        normal_loss[JKRDT::LOSS_DAMPING] = n.loss_damping;
-        loss = normal_loss;
-        U_n = n.U_n;
+        return Eval::DONE;
       }
+      // contact_step()'s normal part now, its tangential step in a lane
+      JKRDT::contact_normal_part(K, layout, m, delta, dt, false, false, eflag, state, out,
+                                 B.y_near[k]);
+      TL.put(nlane++, m, state, layout, out);
+      return Eval::DONE;
+    };
+
+    auto deliver = [&](const Done &o) -> bool {
+      const int p = o.p, q = o.q;
+      const JKRDT::ContactResult &out = o.out;
+      const V3 &fp = out.F1, &d12 = o.d12;
+      const bool broken = out.broken, lossy = out.lossy;
       constexpr int nloss = TANGENTIAL ? JKRDT::NLOSS : JKRDT::LOSS_DAMPING + 1;
-      if (!broken && !std::isfinite(fp.x + fp.y + fp.z))
-        return trouble(Trouble::NOT_FINITE, p, q, 0, 0, K);
-      bonded_slot[s] = !broken;
+      if (!broken && !std::isfinite(fp.x + fp.y + fp.z)) {
+        trouble(Trouble::NOT_FINITE, p, q, 0, 0, constants(p, q));
+        return false;
+      }
+      bonded_slot[o.s] = !broken;
 
       // 5. force on p: normal (eq. 5 and A.5) plus sliding (eq. 14), -force on q; torques
       // eqs. (17), (23), (27); half of the step's dissipation to each owned atom
-      if (!parked)
+      if (!o.parked)
         for (int side = 0; side < 2; side++) {
           const int a = side ? q : p;
           if (a >= nlocal) continue;
@@ -397,8 +447,8 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
             ta = acc.far.back().torque;
             la = acc.far.back().loss;
           }
-          if (lossy && !setup)
-            for (int l = 0; l < nloss; l++) la[l] += 0.5 * loss[l];
+          if (lossy && !o.setup)
+            for (int l = 0; l < nloss; l++) la[l] += 0.5 * out.loss[l];
           if (broken) continue;
           const V3 fa_add = side ? -fp : fp;
           fa[0] += fa_add.x;
@@ -411,21 +461,21 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
             ta[2] += ma.z;
           }
         }
-      if (broken) continue;
+      if (broken) return true;
 
       // energy and virial
-      contact_ends += owned;
-      if (!eflag && !vflag_either) continue;
-      const double share = 0.5 * owned;
-      const double u = TANGENTIAL ? U_n + out.U[0] + out.U[1] + out.U[2] : U_n;
+      contact_ends += o.owned;
+      if (!eflag && !vflag_either) return true;
+      const double share = 0.5 * o.owned;
+      const double u = TANGENTIAL ? out.U_n + out.U[0] + out.U[1] + out.U[2] : out.U_n;
       if (eflag) {
-        acc.upot += share * U_n;
+        acc.upot += share * out.U_n;
         if (TANGENTIAL)
           for (int ch = 0; ch < JKRDT::NCHANNEL; ch++) acc.utan[ch] += share * out.U[ch];
       }
       if (tally_atoms) {
         ev_tally_xyz(p, q, nlocal, 0, u, 0.0, fp.x, fp.y, fp.z, d12.x, d12.y, d12.z);
-        continue;
+        return true;
       }
       // ev_tally_xyz with newton off, by hand: thread-safe into this thread's sums
       if (eflag_global) acc.eng += share * u;
@@ -437,7 +487,26 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
         acc.virial[4] += share * d12.x * fp.z;
         acc.virial[5] += share * d12.y * fp.z;
       }
+      return true;
+    };
+
+    if (!lanes) {
+      for (int k = 0; k < n; k++) {
+        Done o;
+        const Eval e = evaluate(k, o);
+        if (e == Eval::TROUBLE) return;
+        if (e == Eval::DONE && !deliver(o)) return;
+      }
+      continue;
     }
+    for (int k = 0; k < n; k++) {
+      B.eval[k] = evaluate(k, B.done[k]);
+      if (B.eval[k] == Eval::TROUBLE) return;
+    }
+    // 4b. the tangential step of the contacts on its common path, four at a time
+    TL.step(nlane, *scene_K, layout, dt, eflag);
+    for (int k = 0; k < n; k++)
+      if (B.eval[k] == Eval::DONE && !deliver(B.done[k])) return;
   }
   hand_over();
 }

@@ -5,10 +5,12 @@
 // Material: ice of Wada et al. (2007), Table 2; two grains of r = 0.1 micron.
 
 #include "jkr_dt_contact.h"
+#include "jkr_dt_lanes.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <random>
 
 using namespace JKRDT;
@@ -325,6 +327,74 @@ static void fast_forms()
         worst, 0.0, 1e-14);
 }
 
+// the tangential step four contacts at a time (jkr_dt_lanes.h) gives each contact the bits
+// of contact_step() alone: 203 contacts (not a multiple of four), compressed and stretched,
+// damped, turning slowly and beyond the series, within and beyond every elastic limit
+static void lanes_equal_one_contact()
+{
+  const ContactConstants c =
+      contact_constants(ice(true, true, true, 5e-12), R_GRAIN, R_GRAIN);
+  const StateLayout L = state_layout(state_fields(ice(true, true, true, 5e-12)));
+  const double dt = 4.0e-12;
+  constexpr int N = 203;
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  auto random_unit = [&]() { return unit(V3{u(rng), u(rng), u(rng)}); };
+  static JKRDT::TangentialLanes<N> lanes;
+  ContactMotion m[N];
+  ContactResult one[N], four[N];
+  double alone[N][8], laned[N][8], delta[N];
+  int clamped = 0, fast = 0;
+  for (int e = 0; e < N; e++) {
+    const V3 nc = random_unit();
+    delta[e] = c.S.delta0 * (0.5 + 1.5 * u(rng));    // -delta0 ... 2 delta0, past -delta_c
+    m[e].r = 2.0 * R_GRAIN - delta[e];
+    m[e].rinv = 1.0 / m[e].r;
+    m[e].d12 = m[e].r * nc;
+    m[e].v12 = 0.5 * V3{u(rng), u(rng), u(rng)};
+    const double spin = (e % 7 == 0 ? 5e9 : 5e8);    // |omega| dt up to 0.02 or 0.002
+    m[e].w1 = spin * V3{u(rng), u(rng), u(rng)};
+    m[e].w2 = spin * V3{u(rng), u(rng), u(rng)};
+    m[e].vn = dot(m[e].v12, nc);
+    const double tilt = 3.0 * c.K.zeta_crit / R_GRAIN * std::fabs(u(rng));
+    const ContactState st = {unit(-1.0 * nc + tilt * random_unit()),
+                             unit(nc + tilt * random_unit()), 1.5 * c.K.phi_crit * u(rng)};
+    double values[8] = {1e-9 * u(rng)};
+    store_state(values, L, st);
+    std::copy(values, values + 8, alone[e]);
+    std::copy(values, values + 8, laned[e]);
+    contact_step(c, L, m[e], delta[e], dt, false, false, true, alone[e], one[e]);
+    // as the pair loop: a contact that breaks takes contact_step(), the others a lane
+    if (delta[e] < -c.S.delta_c)
+      contact_step(c, L, m[e], delta[e], dt, false, false, true, laned[e], four[e]);
+    else
+      contact_normal_part(c, L, m[e], delta[e], dt, false, false, true, laned[e], four[e]);
+    clamped += one[e].lossy && one[e].loss[LOSS_SLIDING] + one[e].loss[LOSS_ROLLING] +
+        one[e].loss[LOSS_TWISTING] != 0.0;
+    fast += e % 7 == 0;
+  }
+  int count = 0;
+  for (int e = 0; e < N; e++)
+    if (!(delta[e] < -c.S.delta_c)) lanes.put(count++, m[e], laned[e], L, four[e]);
+  lanes.step(count, c, L, dt, true);
+  int differ = 0;
+  for (int e = 0; e < N; e++) {
+    const ContactResult &a = one[e], &b = four[e];
+    const double x[] = {a.F1.x, a.F1.y, a.F1.z, a.M1.x, a.M1.y, a.M1.z, a.M2.x, a.M2.y, a.M2.z,
+                        a.U_n, a.U[0], a.U[1], a.U[2], a.loss[0], a.loss[1], a.loss[2],
+                        a.loss[3], a.loss[4]};
+    const double y[] = {b.F1.x, b.F1.y, b.F1.z, b.M1.x, b.M1.y, b.M1.z, b.M2.x, b.M2.y, b.M2.z,
+                        b.U_n, b.U[0], b.U[1], b.U[2], b.loss[0], b.loss[1], b.loss[2],
+                        b.loss[3], b.loss[4]};
+    for (int k = 0; k < 18; k++) differ += std::memcmp(&x[k], &y[k], sizeof(double)) != 0;
+    for (int k = 0; k < 8; k++) differ += std::memcmp(&alone[e][k], &laned[e][k], 8) != 0;
+    differ += (a.broken != b.broken) + (a.lossy != b.lossy);
+  }
+  check(differ == 0 && clamped > 20 && fast > 20 && count < N,
+        "tangential step in lanes of four = one contact alone (values that differ)", differ, 0,
+        0);
+}
+
 // the per-contact state as the kernel declares it: a full frictional contact with damping
 // stores F_D, n1, n2 and phi (8 values); switching the channels off and on keeps the fields
 // both layouts have and zeroes the others; swapping the particles swaps n1 and n2 only
@@ -359,6 +429,7 @@ int main()
   angular_momentum();
   elastic_oscillation();
   fast_forms();
+  lanes_equal_one_contact();
   state_layouts();
   std::printf("%d failed\n", failures);
   return failures;
