@@ -321,7 +321,7 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
     // is taken four at a time in between, and every pair of the block is delivered after
     // it, in list order, as without it
     int nlane = 0;
-    auto evaluate = [&](int k, Done &o) -> Eval {
+    auto evaluate = [&](int k, Done &o) __attribute__((always_inline)) -> Eval {
       const int i = B.i[k], j = B.j[k], s = B.slot[k];
       const bool bonded = bonded_slot[s];
       V3 d12 = B.d12[k];
@@ -418,7 +418,7 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
       return Eval::DONE;
     };
 
-    auto deliver = [&](const Done &o) -> bool {
+    auto deliver = [&](const Done &o) __attribute__((always_inline)) -> bool {
       const int p = o.p, q = o.q;
       const JKRDT::ContactResult &out = o.out;
       const V3 &fp = out.F1, &d12 = o.d12;
@@ -490,23 +490,25 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
       return true;
     };
 
-    if (!lanes) {
-      for (int k = 0; k < n; k++) {
-        Done o;
-        const Eval e = evaluate(k, o);
-        if (e == Eval::TROUBLE) return;
-        if (e == Eval::DONE && !deliver(o)) return;
+    if constexpr (TANGENTIAL) {
+      if (lanes) {
+        for (int k = 0; k < n; k++) {
+          B.eval[k] = evaluate(k, B.done[k]);
+          if (B.eval[k] == Eval::TROUBLE) return;
+        }
+        // 4b. the tangential step of the contacts on its common path, four at a time
+        TL.step(nlane, *scene_K, layout, dt, eflag);
+        for (int k = 0; k < n; k++)
+          if (B.eval[k] == Eval::DONE && !deliver(B.done[k])) return;
+        continue;
       }
-      continue;
     }
     for (int k = 0; k < n; k++) {
-      B.eval[k] = evaluate(k, B.done[k]);
-      if (B.eval[k] == Eval::TROUBLE) return;
+      Done o;
+      const Eval e = evaluate(k, o);
+      if (e == Eval::TROUBLE) return;
+      if (e == Eval::DONE && !deliver(o)) return;
     }
-    // 4b. the tangential step of the contacts on its common path, four at a time
-    TL.step(nlane, *scene_K, layout, dt, eflag);
-    for (int k = 0; k < n; k++)
-      if (B.eval[k] == Eval::DONE && !deliver(B.done[k])) return;
   }
   hand_over();
 }
