@@ -255,7 +255,6 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
     int p, q, s, owned;
     bool parked, setup;
     V3 d12;
-    double *state;
     JKRDT::ContactMotion m;
     JKRDT::ContactResult out;
   };
@@ -389,7 +388,6 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
       // 4. the contact over the step: the whole kernel, or its normal part alone, or (the
       // lanes' path) the normal part now and the tangential step in a lane
       double *state = layout.dnum ? slot_values + (bigint) s * layout.dnum : nullptr;
-      o.state = state;
       JKRDT::ContactResult &out = o.out;
       if constexpr (!TANGENTIAL) {
         JKRDT::NormalResult nr;
