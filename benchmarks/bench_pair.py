@@ -32,8 +32,8 @@ import argparse
 import json
 import os
 import platform
-import shutil
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -224,17 +224,17 @@ def main(argv=None):
     results: dict = {}
     load = [os.getloadavg()[0]]
     started = time.time()
-    baseline_given = args.baseline
     if args.baseline and not args.baseline.is_file():
         parser.error(f"--baseline {args.baseline}: no such file; give an older build's "
                      "jkrdtplugin.so")
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
+        baseline = None
         if args.baseline:
             # LAMMPS loads the files named *plugin.so of a plugin directory: the baseline
             # gets one of its own, whatever the file given was called
             (tmp / "baseline").mkdir()
-            args.baseline = Path(shutil.copy(args.baseline, tmp / "baseline" / "jkrdtplugin.so"))
+            baseline = Path(shutil.copy(args.baseline, tmp / "baseline" / "jkrdtplugin.so"))
         data = {n: scene(n, args.scenes) for n in args.sizes}
         for rep in range(args.repeat):
             for config in args.configs:
@@ -245,7 +245,7 @@ def main(argv=None):
                     for name, pair in styles.items():
                         deck = DECK.format(data=data[n], pair=pair, steps=steps, dt=dt,
                                            skin=SKIN.get(config, 1.0e-8))
-                        plugin = args.baseline if name.startswith("baseline") else None
+                        plugin = baseline if name.startswith("baseline") else None
                         run = per_atom_step(timed_run(deck, tmp, ranks, threads, plugin),
                                             natoms, steps)
                         run.update(steps=steps, repeat=rep)
@@ -268,7 +268,7 @@ def main(argv=None):
         sizes=args.sizes, configs={c: dict(zip(("ranks", "threads"), CONFIGS[c]))
                                    for c in args.configs},
         repeat=args.repeat, atom_steps=args.atom_steps,
-        baseline=str(baseline_given) if baseline_given else None,
+        baseline=str(args.baseline) if args.baseline else None,
         machine=dict(arch=platform.machine(), cpus=os.cpu_count(),
                      load_average_1min=load),
         wall_seconds=time.time() - started,
