@@ -228,7 +228,8 @@ class PairJKRDT : public Pair {
   bool kernel_logged = false;
   [[noreturn]] void report(const Trouble &t) const;
   int nthreads_used() const;
-  std::vector<int> thread_of;         // owning thread of each owned atom (threaded runs) ...
+  std::vector<int> thread_from;       // first ilist entry of each thread (threaded runs) ...
+  std::vector<int> thread_of;         // ... the owning thread of each owned atom ...
   bigint thread_of_build = -1;        // ... for the list of this build
   int thread_of_threads = 0;          // ... and this many threads
   std::vector<Accumulator> accumulators;
