@@ -309,6 +309,38 @@ def test_seed_2_follows_v_fra_where_it_moves():
     assert seed_2_missing(both + [run(63.1, 2, -0.2)], offsets=2) == [63.1]
 
 
+def test_both_seeds_run_further_when_only_seed_1_brackets_v_fra(monkeypatch, tmp_path):
+    # 2 x 5000, undamped frictional: seed 1 grew at 63.1 m/s and fell to <= 0 at 79.4, so
+    # seed 2 ran at those two speeds and grew at both; both seeds' <f_gro> is then > 0 at
+    # every speed run. The study must run both seeds at the paper's next speed (100 m/s),
+    # then stop once both seeds' curve crosses 0
+    sys.path.insert(0, str(ROOT / "validation"))
+    try:
+        import vfra_size
+    finally:
+        sys.path.pop(0)
+    f_gro = {(1, 39.8): 0.3, (1, 50.1): 0.2, (1, 63.1): 0.05, (1, 79.4): -0.02,
+             (2, 63.1): 0.08, (2, 79.4): 0.03, (1, 100.0): -0.1, (2, 100.0): -0.08}
+    ran, calls = [], []
+
+    def campaign(name, model, n, speeds, b_off2, seed, home, ranks, ledger):
+        calls.append((name, seed, tuple(speeds)))
+        new = [dict(v_col=v, B_off=0.0, seed=seed, growth_efficiency=f_gro[seed, v],
+                    stop_reason="settled") for v in speeds]
+        ran.extend(new)
+        return new
+
+    monkeypatch.setattr(vfra_size, "campaign", campaign)
+    monkeypatch.setattr(vfra_size, "finished", lambda home, n, model, ledger: list(ran))
+    plan = dict(grids={"frictional": [39.8, 50.1, 63.1, 79.4]}, b_off2=[0.0], extend=3,
+                follow=2)
+    vfra_size.run_model("frictional", 5000, plan, tmp_path, 1, [])
+    assert calls == [("seed1", 1, (39.8, 50.1, 63.1, 79.4)), ("seed2", 2, (63.1, 79.4)),
+                     ("seed1_v100", 1, (100.0,)), ("seed2_v100", 2, (100.0,))]
+    both = vfra_size.curve(ran)
+    assert both["bracket"] == [79.4, 100.0]
+
+
 def test_the_size_trend_places_v_fra_as_the_smaller_study_did():
     # validation/vfra_size.py takes the committed runs of bpca3d_models (2 x 100, 250,
     # 1000) into its trend of v_fra against N: from those rows it must find the v_fra that

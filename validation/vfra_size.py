@@ -12,7 +12,9 @@ brackets each model's v_fra as the smaller sizes place it (GRIDS), at B_off^2 = 
             next speed beyond the grid on that side, one speed at a time (at most EXTEND,
             within 10-125.9 m/s);
   phase 2   seed 2 at the two speeds on either side of seed 1's v_fra, then at the speeds
-            on either side of both seeds' v_fra where it has not run yet.
+            on either side of both seeds' v_fra where it has not run yet;
+  both      if both seeds' <f_gro> does not cross 0 on the speeds run (seed 1's alone did),
+            both seeds at the paper's next speed on that side, as in extend.
 
 Each model's phases are campaigns of their own (``RUNS/n<N>/<model>/seed<k>``, an added
 speed ``seed<k>_v<speed>``), run one after the other, damped models first (their gap to
@@ -363,6 +365,16 @@ def run_model(model: str, n: int, plan: dict, runs: Path, ranks: int,
         for speed in missing:
             campaign(f"{second}_v{speed:g}", model, n, [speed], offsets, SEEDS[1], home,
                      ranks, ledger)
+    # seed 1 alone may bracket v_fra where the two seeds together do not (2 x 5000
+    # frictional: seed 1 fell to <= 0 at 79.4 m/s, both seeds' <f_gro> there was +0.004):
+    # both seeds then run at the paper's next speed on that side, as far as EXTEND allows
+    for _ in range(plan["extend"]):
+        speed = next_speed(curve(finished(home, n, model, ledger)))
+        if speed is None:
+            break
+        for seed in SEEDS:
+            campaign(f"seed{seed}_v{speed:g}", model, n, [speed], offsets, seed, home, ranks,
+                     ledger)
 
 
 def seed_2_missing(rows: list[dict], offsets: int) -> list[float]:
