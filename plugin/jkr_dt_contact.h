@@ -382,9 +382,9 @@ inline auto tangential_common_step(const ContactConstants &c, const V3T<T> &d12,
   if (K.twisting) s.phi = s.phi + twist_increment(d12, v12, w1, w2, rinv, nc, dt);
   const DisplacementsT<T> d = displacements(s, nc, c.r1, c.r2, R);    // eqs. (8)-(20)
   // within the elastic limits (the clamps of eqs. 42, A8 would not act)
-  if (K.sliding) on &= dot(d.zeta, d.zeta) <= K.zeta_crit * K.zeta_crit;
-  if (K.rolling) on &= dot(d.xi, d.xi) <= K.xi_crit * K.xi_crit;
-  if (K.twisting) on &= (s.phi <= K.phi_crit) & (s.phi >= -K.phi_crit);
+  if (K.sliding) on &= !sliding_beyond(K, dot(d.zeta, d.zeta));
+  if (K.rolling) on &= !rolling_beyond(K, dot(d.xi, d.xi));
+  if (K.twisting) on &= !twisting_beyond(K, s.phi);
   add_tangential_loads(s, d, nc, rinv, c.r1, c.r2, R, K, energy, F1, M1, M2, U);
   return on;
 }

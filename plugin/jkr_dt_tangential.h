@@ -155,6 +155,23 @@ struct Tangential {
 constexpr double PHI_CRIT = 1.0 / (16.0 * PI);
 inline double phi_crit() { return PHI_CRIT; }
 
+// a channel beyond its elastic limit (|zeta| > zeta_crit, eq. 36; |xi| > xi_crit;
+// |phi| > phi_crit, eq. 38), where section 2.2.5's clamp acts; for one contact (T = double)
+// and for a lane of four (T = Lanes4, a mask per lane). A NaN is never beyond: it goes on
+// to the force, where the pair loop names it
+template <class T> inline auto sliding_beyond(const Tangential &K, const T &zeta2)
+{
+  return zeta2 > K.zeta_crit * K.zeta_crit;
+}
+template <class T> inline auto rolling_beyond(const Tangential &K, const T &xi2)
+{
+  return xi2 > K.xi_crit * K.xi_crit;
+}
+template <class T> inline auto twisting_beyond(const Tangential &K, const T &phi)
+{
+  return (phi > K.phi_crit) | (phi < -K.phi_crit);
+}
+
 /* ---------------------------------------------------------------------
    displacements, eqs. (8)-(10) and (20)
 ------------------------------------------------------------------------ */
@@ -344,7 +361,7 @@ inline V3 corrected_pointer(const V3 &n, const V3 &shift)
     d.zeta = tangential_part(d.zeta0, nc);
     const V3 &zeta = d.zeta;
     const double z2 = dot(zeta, zeta);
-    if (z2 > K.zeta_crit * K.zeta_crit) {
+    if (sliding_beyond(K, z2)) {
       const double z = std::sqrt(z2);
       const V3 shift = ((1.0 - K.zeta_crit / z) / (r1 + r2)) * zeta;    // dzeta / (r1 + r2)
       c.n1 = corrected_pointer(c.n1, shift);                            // eq. (42)
@@ -356,7 +373,7 @@ inline V3 corrected_pointer(const V3 &n, const V3 &shift)
     d.xi = rolling_xi(c, R);
     const V3 &xi = d.xi;
     const double x2 = dot(xi, xi);
-    if (x2 > K.xi_crit * K.xi_crit) {
+    if (rolling_beyond(K, x2)) {
       const double x = std::sqrt(x2);
       const V3 dxi = (1.0 - K.xi_crit / x) * xi;
       c.n1 = corrected_pointer(c.n1, (1.0 / r1) * dxi);                 // eq. (42) for rolling
@@ -364,7 +381,7 @@ inline V3 corrected_pointer(const V3 &n, const V3 &shift)
       clamped |= 1 << ROLL;
     }
   }
-  if (K.twisting && std::fabs(c.phi) > K.phi_crit) {
+  if (K.twisting && twisting_beyond(K, c.phi)) {
     c.phi = std::copysign(K.phi_crit, c.phi);
     clamped |= 1 << TWIST;
   }
