@@ -2,8 +2,9 @@
 head-on collisions of 2 x 32 grains, quartz and ice, xi_crit = 2 A, 5 speeds, 2 seeds,
 against Wada et al. 2007) and validation/bpca3d_models.py (the 3D BPCA paper's four
 models at 2 x 24 grains), validation/two_grain_sticking.py (the sticking threshold of
-two grains without and with the damping of eq. A.5) and validation/departure.py (fragments
-that depart against fragments kept flying, 2 x 50 grains shattering, 4 seeds)."""
+two grains without and with the damping of eq. A.5), validation/departure.py (fragments
+that depart against fragments kept flying, 2 x 50 grains shattering, 4 seeds) and
+validation/b_off_grid.py (<f_gro> over the paper's twelfths of B_off^2 and over four)."""
 
 import json
 import shutil
@@ -256,6 +257,29 @@ def test_the_damped_tension_study_runs_the_variant_and_its_ledgers_close(tmp_pat
     mine = [r["growth_efficiency"] for r in runs if r["variant"] == "damp_tension off"]
     assert f["damp_tension_off"][0] == pytest.approx(np.mean(mine), abs=1e-12)
     assert f["agree"] == (abs(f["difference"]) <= 2 * f["se"])
+
+
+def test_the_offset_grid_study_averages_the_papers_twelfths_and_the_four(tmp_path):
+    # validation/b_off_grid.py --quick: frictional 2 x 24 ice BPCAs at 15.8 m/s, one seed,
+    # B_off^2 = 0, 1/12, 2/12, 3/12, 6/12, 9/12, 1. Far below v_fra the head-on pair sticks
+    # whole (f_gro = 1); at B_off = 1 the characteristic spheres only touch and the two
+    # aggregates part whole (f_gro = 0, at most a grain moved). <f_gro> of eq. (1) is the
+    # trapezoid in B_off^2 over every offset run, and over the four of the other studies
+    # with the 9/12 value held to 1
+    results = run_quick("b_off_grid", tmp_path)
+    summary = json.loads((results / "summary.json").read_text())
+    runs = read_csv(results / "runs.csv")
+    assert len(runs) == 7 and all(r["stop_reason"] == "settled" for r in runs)
+    assert max(r["energy_error"] for r in runs) < 1e-3
+    f = {round(r["B_off"] ** 2 * 12): r["growth_efficiency"] for r in runs}
+    assert f[0] == 1.0
+    assert abs(f[12]) <= 1 / 24
+    a = summary["results"]["frictional at 15.8 m/s"]
+    b2 = sorted(f)
+    assert a["mean_f_gro_all"] == pytest.approx(
+        np.trapezoid([f[k] for k in b2], [k / 12 for k in b2]), abs=1e-12)
+    assert a["mean_f_gro_four"] == pytest.approx(
+        np.trapezoid([f[0], f[3], f[6], f[9], f[9]], [0, 0.25, 0.5, 0.75, 1.0]), abs=1e-12)
 
 
 def test_a_grid_that_misses_v_fra_is_extended_along_the_papers_speeds():

@@ -1,0 +1,122 @@
+"""Does the grid of offsets move <f_gro>? The paper's B_off^2 step of 1/12 against four.
+
+The 3D BPCA paper ran B_off^2 from 0 to 1 in steps of 1/12 (its Appendix B, Fig. B.1) and
+averaged f_gro over them by eq. (1), <A> = integral of A d(B_off^2). This project's
+studies run B_off^2 = 0, 3/12, 6/12, 9/12 and average by ``b_off_average`` (the trapezoid
+rule in B_off^2, the last value held to 1), which gives the head-on collision a weight of
+1/8 where the paper's step gives it 1/24. Where f_gro falls from about 1 head-on to below
+0 within a few twelfths, that weight can decide the sign of <f_gro>: the damped frictional
+model at 2 x 5000 grains and 100 m/s has f_gro 0.97 head-on and -0.16, -0.07, -0.02 at
+the other three offsets (``vfra_size``), so +0.12 of its <f_gro> of +0.06 is the head-on
+run's. This study runs one collision per twelfth, B_off^2 = k/12, k = 0 ... 12, one seed
+(the same two aggregates at every offset), and reads <f_gro> twice from the same runs:
+over all 13 offsets, and over the four that the other studies use.
+
+Writes RESULTS (default validation/b_off_grid/): runs.csv, summary.json and fig_b_off_grid
+(f_gro against B_off^2 per model and speed, with both averages).
+
+    ./run validate b_off_grid                 # 2 models x 13 offsets at 2 x 1000, 2 ranks
+    ./run validate b_off_grid --quick         # 2 x 24 grains, 7 offsets (tests)
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from bpca3d_models import model_spec
+from common import (campaign_paths, campaign_study_parser, run_campaigns, save, study_paths,
+                    write_summary)
+from jkrdt.analysis.summary import b_off_average
+from jkrdt.analysis.tables import write_csv
+from jkrdt.stopping import COMPLETE
+from vfra_size import SMALLER_PLAN, TOLERANCE, model_home, outcome_rows
+
+#: the paper's offsets (Appendix B) and the four of the other studies (bpca3d_models)
+TWELFTHS = [k / 12 for k in range(13)]
+FOUR = SMALLER_PLAN["b_off2"]
+FULL = dict(n=1000, v_col=[63.1], b_off2=TWELFTHS, seeds=[1],
+            models=["frictional, T_vis 6 ps", "frictional"])
+QUICK = dict(n=24, v_col=[15.8], b_off2=[k / 12 for k in (0, 1, 2, 3, 6, 9, 12)], seeds=[1],
+             models=["frictional"])
+
+
+def spec(plan: dict, model: str) -> dict:
+    return model_spec(model, plan["n"], v_col=plan["v_col"], b_off2=plan["b_off2"],
+                      seeds=plan["seeds"], dt="auto", tolerance=TOLERANCE)
+
+
+def averages(rows: list[dict]) -> dict:
+    """f_gro per B_off^2 (seeds averaged) of one model and speed, and <f_gro> of eq. (1)
+    over every offset run and over the four of the other studies alone."""
+    by_b2 = {}
+    for r in rows:
+        by_b2.setdefault(round(r["B_off"] ** 2, 9), []).append(r["growth_efficiency"])
+    b2 = sorted(by_b2)
+    f = [sum(by_b2[b]) / len(by_b2[b]) for b in b2]
+    four = [k for k, b in enumerate(b2) if any(abs(b - x) < 1e-6 for x in FOUR)]
+    return dict(b_off2=b2, f_gro=f,
+                mean_f_gro_all=float(b_off_average(b2, f)),
+                mean_f_gro_four=(float(b_off_average([b2[k] for k in four],
+                                                     [f[k] for k in four]))
+                                 if len(four) == len(FOUR) else None))
+
+
+def figure(results_by: dict, results: Path) -> list[Path]:
+    """fig_b_off_grid: f_gro against B_off^2, a panel per model, a line per speed, with the
+    two averages of eq. (1) in the legend and the four offsets of the other studies marked."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    models = sorted({m for m, _ in results_by})
+    fig, axes = plt.subplots(1, len(models), figsize=(5.5 * len(models), 4.2), squeeze=False,
+                             sharey=True, constrained_layout=True)
+    for ax, model in zip(axes[0], models):
+        for k, ((m, v), a) in enumerate(sorted(results_by.items())):
+            if m != model:
+                continue
+            four = a["mean_f_gro_four"]
+            label = (f"{v:g} m/s: <f_gro> {a['mean_f_gro_all']:+.3f} (every 1/12)"
+                     + (f", {four:+.3f} (the four)" if four is not None else ""))
+            ax.plot(a["b_off2"], a["f_gro"], "o-", color=f"C{k}", ms=4, label=label)
+            at = [j for j, b in enumerate(a["b_off2"]) if any(abs(b - x) < 1e-6 for x in FOUR)]
+            ax.plot([a["b_off2"][j] for j in at], [a["f_gro"][j] for j in at], "s", ms=9,
+                    mfc="none", color=f"C{k}")
+        ax.axhline(0, color="0.7", lw=0.8)
+        ax.set_xticks([k / 12 for k in range(0, 13, 3)], ["0", "3/12", "6/12", "9/12", "1"])
+        ax.set_xlabel("B_off^2 (squares: the four offsets of the other studies)")
+        ax.set_title(model, fontsize=9)
+        ax.legend(fontsize=7)
+    axes[0][0].set_ylabel("f_gro = (N_lar - N_tar) / N_pro")
+    fig.suptitle("Ice BPCAs, one seed: f_gro at every twelfth of B_off^2 (the paper's "
+                 "Appendix B grid)", fontsize=10)
+    return save(fig, results, "fig_b_off_grid")
+
+
+def main(argv=None) -> int:
+    args = campaign_study_parser(__doc__).parse_args(argv)
+    plan = QUICK if args.quick else FULL
+    runs, results = study_paths(args, "b_off_grid")
+    rows = []
+    for model in plan["models"]:
+        home = model_home(runs, plan["n"], model)
+        specs = {"twelfths": spec(plan, model)}
+        run_campaigns(specs, home, args.np)
+        rows += [r for r in outcome_rows(campaign_paths(specs, home)["twelfths"], plan["n"],
+                                         model) if r["stop_reason"] in COMPLETE]
+    write_csv(results / "runs.csv", rows)
+    results_by = {(m, v): averages([r for r in rows if r["model"] == m and r["v_col"] == v])
+                  for m in plan["models"] for v in plan["v_col"]
+                  if any(r["model"] == m and r["v_col"] == v for r in rows)}
+    figure(results_by, results)
+    summary = dict(plan=plan, tolerance=TOLERANCE,
+                   results={f"{m} at {v:g} m/s": a for (m, v), a in results_by.items()},
+                   runs_finished=len(rows),
+                   loop_minutes=sum(r["loop_seconds"] for r in rows) / 60,
+                   energy_error_max=max((r["energy_error"] for r in rows), default=None))
+    return write_summary(results, summary)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
