@@ -66,9 +66,11 @@ def campaign_paths(specs: dict[str, dict], runs: Path) -> dict[str, Path]:
     return {name: runs / re.sub(r"[^A-Za-z0-9.]+", "_", name) for name in specs}
 
 
-def run_campaigns(specs: dict[str, dict], runs: Path, ranks: int) -> dict[str, Path]:
+def run_campaigns(specs: dict[str, dict], runs: Path, ranks: int,
+                  ranks_per_run: int = 1) -> dict[str, Path]:
     """Run one ``jkrdt campaign`` per spec (``runs/<name>``), each over ``ranks`` MPI ranks
-    in groups of one; a second call resumes them. Returns the campaign directories."""
+    in groups of ``ranks_per_run`` (each group runs whole collisions); a second call resumes
+    them. Returns the campaign directories."""
     runs.mkdir(parents=True, exist_ok=True)
     where = campaign_paths(specs, runs)
     for name, spec in specs.items():
@@ -76,7 +78,8 @@ def run_campaigns(specs: dict[str, dict], runs: Path, ranks: int) -> dict[str, P
         path.write_text(json.dumps(spec))
         cmd = [str(BIN / "jkrdt"), "campaign", str(path), str(where[name]), "--quiet"]
         if ranks > 1:
-            cmd = [str(BIN / "mpirun"), "-np", str(ranks)] + cmd
+            cmd = [str(BIN / "mpirun"), "-np", str(ranks)] + cmd + \
+                ["--ranks-per-run", str(min(ranks_per_run, ranks))]
         t0 = time.time()
         done = subprocess.run(cmd)
         if done.returncode not in (0, 1):        # 1: some runs failed, recorded as such

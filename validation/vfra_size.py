@@ -185,21 +185,23 @@ def finished(home: Path, n: int, model: str, ledger: list[dict], seed: int | Non
 
 
 def campaign(name: str, model: str, n: int, speeds: list[float], b_off2: list[float],
-             seed: int, home: Path, ranks: int, ledger: list[dict]) -> list[dict]:
+             seed: int, home: Path, ranks: int, ledger: list[dict],
+             ranks_per_run: int = 1) -> list[dict]:
     """The campaign ``home/name`` of ``seed`` at ``speeds`` x ``b_off2``, unless its every
     run is finished; its finished runs. Where the ledger holds some of its speeds and the
     campaign is not on disk (a new machine), each speed it lacks runs as a campaign of its
-    own (``name_v<speed>``)."""
+    own (``name_v<speed>``). ``ranks_per_run``: the ranks that share one collision."""
     held = {row_key(r) for r in finished(home, n, model, ledger, seed, speeds)}
     missing = [v for v in speeds if any((n, model, seed, round(v, 4), round(b2, 4))
                                         not in held for b2 in b_off2)]
     if not missing:
         print(f"{name}: every run finished (on disk or in the committed runs.csv)", flush=True)
     elif campaign_paths({name: None}, home)[name].exists() or missing == speeds:
-        run_campaigns({name: spec(model, n, speeds, b_off2, seed)}, home, ranks)
+        run_campaigns({name: spec(model, n, speeds, b_off2, seed)}, home, ranks, ranks_per_run)
     else:
         for v in missing:
-            run_campaigns({f"{name}_v{v:g}": spec(model, n, [v], b_off2, seed)}, home, ranks)
+            run_campaigns({f"{name}_v{v:g}": spec(model, n, [v], b_off2, seed)}, home, ranks,
+                          ranks_per_run)
     return finished(home, n, model, ledger, seed, speeds)
 
 
@@ -386,12 +388,13 @@ def seed_2_missing(rows: list[dict], offsets: int) -> list[float]:
 
 def run_paper_size(runs: Path, ranks: int, b_off2: list[float], ledger: list[dict]) -> None:
     """The 12 collisions of PAPER_SIZE at 2 x 50000 grains, seed 1, the offsets ``b_off2``
-    of each model before the next offsets of any (one campaign per model and offsets)."""
+    of each model before the next offsets of any (one campaign per model and offsets, its
+    one collision across all ``ranks``)."""
     n = PAPER_SIZE["n"]
     for b2 in b_off2:
         for model, v in PAPER_SIZE["speeds"].items():
             campaign(f"v{v:g}_b2_{b2:.4f}", model, n, [v], [b2], SEEDS[0],
-                     model_home(runs, n, model), ranks, ledger)
+                     model_home(runs, n, model), ranks, ledger, ranks_per_run=ranks)
 
 
 def size_summary(mine: list[dict], model: str) -> dict:
