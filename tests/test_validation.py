@@ -365,6 +365,31 @@ def test_both_seeds_run_further_when_only_seed_1_brackets_v_fra(monkeypatch, tmp
     assert both["bracket"] == [79.4, 100.0]
 
 
+def test_the_damping_effect_is_the_damped_curve_minus_its_undamped_twin():
+    # per size, at the speeds both models ran: <f_gro> (eq. 1) with damping minus without;
+    # the paper has the two frictional models within about 0.1 of each other
+    sys.path.insert(0, str(ROOT / "validation"))
+    try:
+        from vfra_size import damping_effect
+    finally:
+        sys.path.pop(0)
+
+    def run(model, v, f, b2):
+        return dict(size=1000, model=model, v_col=v, B_off=b2 ** 0.5, seed=1,
+                    growth_efficiency=f, stop_reason="settled")
+
+    rows = [run("frictional", v, f, b2) for v, f in ((63.1, 0.2), (100.0, -0.1))
+            for b2 in (0.0, 0.5)]
+    rows += [run("frictional, T_vis 6 ps", v, f, b2) for v, f in ((50.1, 0.5), (63.1, 0.25),
+                                                                  (100.0, 0.2))
+             for b2 in (0.0, 0.5)]
+    effect = damping_effect(rows)["frictional, T_vis 6 ps"]["2000"]
+    assert effect["v_col"] == [63.1, 100.0]
+    assert effect["difference"] == pytest.approx([0.05, 0.3], abs=1e-12)
+    assert effect["largest"] == pytest.approx(0.3, abs=1e-12)
+    assert damping_effect(rows)["frictionless, T_vis 6 ps"] == {}
+
+
 def test_the_size_trend_places_v_fra_as_the_smaller_study_did():
     # validation/vfra_size.py takes the committed runs of bpca3d_models (2 x 100, 250,
     # 1000) into its trend of v_fra against N: from those rows it must find the v_fra that

@@ -243,6 +243,31 @@ def size_trend(rows: list[dict]) -> dict:
     return out
 
 
+#: each damped model and its undamped twin (MODELS)
+TWINS = {"frictional, T_vis 6 ps": "frictional", "frictionless, T_vis 6 ps": "frictionless"}
+
+
+def damping_effect(rows: list[dict]) -> dict:
+    """Per damped model and size: <f_gro> with damping minus without, at the speeds both
+    ran, and the largest |difference|. The paper has the frictional models within about
+    0.1 of each other over 10-100 m/s at 10^5 grains (its Sec. 3.1), the frictionless ones
+    apart."""
+    out = {}
+    for damped, undamped in TWINS.items():
+        by_size = {}
+        for size in sorted({r["size"] for r in rows}):
+            c = {m: curve([r for r in rows if r["size"] == size and r["model"] == m])
+                 for m in (damped, undamped)}
+            f = {m: dict(zip(c[m]["v_col"], c[m]["mean_f_gro"])) for m in c}
+            common = sorted(set(f[damped]) & set(f[undamped]))
+            if common:
+                diff = [f[damped][v] - f[undamped][v] for v in common]
+                by_size[str(int(2 * size))] = dict(v_col=common, difference=diff,
+                                              largest=max(diff, key=abs))
+        out[damped] = by_size
+    return out
+
+
 def figure(trend: dict, paper_size: dict, results: Path) -> list[Path]:
     """fig_vfra_size: v_fra against N_total per model, the seeds' range as error bars,
     sizes whose speeds place no v_fra as open triangles at the bound they give (up: above
@@ -488,7 +513,8 @@ def main(argv=None) -> int:
     growth_figure(before + rows, paper_size, results)
     summary = dict(plan=plan, tolerance=TOLERANCE, ranks=args.np,
                    seconds_this_call=time.time() - t0, load=os.getloadavg()[0], sizes=sizes,
-                   trend=trend, paper_size=paper_size,
+                   trend=trend, damping_effect=damping_effect(before + rows),
+                   paper_size=paper_size,
                    under_way={n: {m: len(x) for m, x in by.items()}
                               for n, by in under_way.items()})
     (results / "summary.json").write_text(json.dumps(summary, indent=2, default=float) + "\n")
