@@ -249,7 +249,7 @@ TWINS = {"frictional, T_vis 6 ps": "frictional", "frictionless, T_vis 6 ps": "fr
 
 def damping_effect(rows: list[dict]) -> dict:
     """Per damped model and size: <f_gro> with damping minus without, at the speeds both
-    ran, and the largest |difference|. The paper has the frictional models within about
+    ran, and the largest of these differences in size (with its sign). The paper has the frictional models within about
     0.1 of each other over 10-100 m/s at 10^5 grains (its Sec. 3.1), the frictionless ones
     apart."""
     out = {}
@@ -263,7 +263,7 @@ def damping_effect(rows: list[dict]) -> dict:
             if common:
                 diff = [f[damped][v] - f[undamped][v] for v in common]
                 by_size[str(int(2 * size))] = dict(v_col=common, difference=diff,
-                                              largest=max(diff, key=abs))
+                                                   largest=max(diff, key=abs))
         out[damped] = by_size
     return out
 
