@@ -182,7 +182,12 @@ def test_the_size_study_places_v_fra_and_runs_seed_2_where_it_lies(tmp_path):
     # the frictionless bound of jkrdt.timestep was fit on 2 x 100 grains and more; at
     # 2 x 24 and 10 m/s it came out 18 % above the tolerance (1.18e-3), so 2x here
     assert max(r["energy_error"] for r in runs) < 2e-3
+    # a campaign on 2 ranks runs one collision per rank: each run's compute is its loop
+    # time on one core
+    assert all(r["ranks"] == 1 for r in runs)
     for model, c in at.items():
+        assert c["core_hours"] == pytest.approx(
+            sum(r["loop_seconds"] for r in runs if r["model"] == model) / 3600, rel=1e-12)
         # v_fra lies between the grid speeds where <f_gro> turns from > 0 to <= 0; seed 2
         # ran at the two speeds on either side of seed 1's v_fra (which seed 2 may move),
         # at both offsets

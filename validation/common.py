@@ -48,6 +48,16 @@ def loop_seconds(run: Path) -> float:
                re.finditer(r"Loop time of ([0-9.eE+-]+)", (run / LOG).read_text()))
 
 
+def loop_ranks(run: Path) -> int:
+    """The MPI ranks that a run directory's runs used (its log's 'Loop time ... on N procs';
+    1 if it says nothing): with ``loop_seconds``, the core-seconds the run cost."""
+    from jkrdt.rundir import LOG
+
+    return max((int(m.group(1)) for m in
+                re.finditer(r"Loop time of \S+ on (\d+) procs", (run / LOG).read_text())),
+               default=1)
+
+
 def read_committed(results: Path, ints: tuple[str, ...]) -> list[dict]:
     """The rows of a study's committed ``results/runs.csv``, the columns ``ints`` as whole
     numbers (none if there is no such file yet): what earlier calls, on this machine or

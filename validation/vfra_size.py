@@ -57,8 +57,8 @@ from pathlib import Path
 import numpy as np
 
 from bpca3d_models import FULL as SMALLER_PLAN, MODELS, model_spec
-from common import (HERE, campaign_paths, campaign_study_parser, loop_seconds, read_committed,
-                    run_campaigns, save, study_paths)
+from common import (HERE, campaign_paths, campaign_study_parser, loop_ranks, loop_seconds,
+                    read_committed, run_campaigns, save, study_paths)
 from jkrdt import rundir
 from jkrdt.analysis.summary import b_off_mean, threshold_velocity
 from jkrdt.analysis.tables import read_csv, write_csv
@@ -151,6 +151,7 @@ def outcome_rows(home: Path, n: int, model: str) -> list[dict]:
     read where its outcome lies (the path an outcome records may be relative to where its
     campaign was started)."""
     return [dict(size=n, model=model, loop_seconds=loop_seconds(p.parent),
+                 ranks=loop_ranks(p.parent),
                  dt_over_tc=rundir.read_metadata(p.parent)["dt_over_tc"],
                  **{k: o.get(k) for k in (
                      "v_col", "B_off", "seed", "n_total", "n_largest", "n_fragments",
@@ -160,7 +161,13 @@ def outcome_rows(home: Path, n: int, model: str) -> list[dict]:
 
 
 #: the columns of runs.csv that hold whole numbers
-INTS = ("size", "seed", "n_total", "n_largest", "n_fragments", "stop_step")
+INTS = ("size", "seed", "n_total", "n_largest", "n_fragments", "stop_step", "ranks")
+
+
+def core_hours(rows: list[dict]) -> float:
+    """The compute the runs in ``rows`` took: loop time times the ranks each used (rows of
+    the ledger from before ranks were recorded ran on one)."""
+    return sum(r["loop_seconds"] * (r.get("ranks") or 1) for r in rows) / 3600
 
 
 def row_key(r: dict) -> tuple:
@@ -249,9 +256,9 @@ TWINS = {"frictional, T_vis 6 ps": "frictional", "frictionless, T_vis 6 ps": "fr
 
 def damping_effect(rows: list[dict]) -> dict:
     """Per damped model and size: <f_gro> with damping minus without, at the speeds both
-    ran, and the largest of these differences in size (with its sign). The paper has the frictional models within about
-    0.1 of each other over 10-100 m/s at 10^5 grains (its Sec. 3.1), the frictionless ones
-    apart."""
+    ran, and the largest of these differences in size (with its sign). The paper has the
+    frictional models within about 0.1 of each other over 10-100 m/s at 10^5 grains (its
+    Sec. 3.1), the frictionless ones apart."""
     out = {}
     for damped, undamped in TWINS.items():
         by_size = {}
@@ -262,8 +269,8 @@ def damping_effect(rows: list[dict]) -> dict:
             common = sorted(set(f[damped]) & set(f[undamped]))
             if common:
                 diff = [f[damped][v] - f[undamped][v] for v in common]
-                by_size[str(int(2 * size))] = dict(v_col=common, difference=diff,
-                                                   largest=max(diff, key=abs))
+                by_size[str(int(2 * size))] = dict(
+                    v_col=common, difference=diff, largest=max(diff, key=abs))
         out[damped] = by_size
     return out
 
@@ -432,7 +439,7 @@ def size_summary(mine: list[dict], model: str) -> dict:
              stop_reasons={k: sum(r["stop_reason"] == k for r in mine)
                            for k in sorted({r["stop_reason"] for r in mine})},
              energy_error_max=max(r["energy_error"] for r in mine),
-             core_hours=sum(r["loop_seconds"] for r in mine) / 3600)
+             core_hours=core_hours(mine))
     return c
 
 
@@ -450,7 +457,7 @@ def paper_size_summary(rows: list[dict]) -> dict:
             mean_f_gro=(float(b_off_mean(mine, lambda r: r["growth_efficiency"]))
                         if len(mine) == len(PAPER_SIZE["b_off2"]) else None),
             energy_error_max=max(r["energy_error"] for r in mine),
-            core_hours=sum(r["loop_seconds"] for r in mine) / 3600)
+            core_hours=core_hours(mine))
     return out
 
 
