@@ -31,7 +31,7 @@ from pathlib import Path
 from bpca3d_models import model_spec
 from common import (campaign_paths, campaign_study_parser, run_campaigns, save, study_paths,
                     write_summary)
-from jkrdt.analysis.summary import b_off_average
+from jkrdt.analysis.summary import b_off_mean
 from jkrdt.analysis.tables import write_csv
 from jkrdt.stopping import COMPLETE
 from vfra_size import SMALLER_PLAN, TOLERANCE, model_home, outcome_rows
@@ -50,20 +50,30 @@ def spec(plan: dict, model: str, v_col: float) -> dict:
                       seeds=plan["seeds"], dt="auto", tolerance=TOLERANCE)
 
 
+def one_of_four(b_off2: float) -> bool:
+    """Whether ``b_off2`` is one of the four offsets of the other studies."""
+    return any(abs(b_off2 - x) < 1e-6 for x in FOUR)
+
+
+def growth(run: dict) -> float:
+    """f_gro of one run, the value eq. (1) averages here."""
+    return run["growth_efficiency"]
+
+
 def averages(rows: list[dict]) -> dict:
     """f_gro per B_off^2 (seeds averaged) of one model and speed, and <f_gro> of eq. (1)
-    over every offset run and over the four of the other studies alone."""
+    (``b_off_mean``) over every offset run and over the four of the other studies alone."""
     by_b2 = {}
     for r in rows:
         by_b2.setdefault(round(r["B_off"] ** 2, 9), []).append(r["growth_efficiency"])
     b2 = sorted(by_b2)
-    f = [sum(by_b2[b]) / len(by_b2[b]) for b in b2]
-    four = [k for k, b in enumerate(b2) if any(abs(b - x) < 1e-6 for x in FOUR)]
-    return dict(b_off2=b2, f_gro=f,
-                mean_f_gro_all=float(b_off_average(b2, f)),
-                mean_f_gro_four=(float(b_off_average([b2[k] for k in four],
-                                                     [f[k] for k in four]))
-                                 if len(four) == len(FOUR) else None))
+    four = [r for r in rows if one_of_four(r["B_off"] ** 2)]
+    return dict(b_off2=b2, f_gro=[sum(by_b2[b]) / len(by_b2[b]) for b in b2],
+                mean_f_gro_all=float(b_off_mean(rows, growth)),
+                mean_f_gro_four=(float(b_off_mean(four, growth))
+                                 if len({round(r["B_off"] ** 2, 9) for r in four}) == len(FOUR)
+                                 else None))
+
 
 
 def figure(results_by: dict, results: Path) -> list[Path]:
@@ -84,7 +94,7 @@ def figure(results_by: dict, results: Path) -> list[Path]:
             label = (f"{v:g} m/s: <f_gro> {a['mean_f_gro_all']:+.3f} (every 1/12)"
                      + (f", {four:+.3f} (the four)" if four is not None else ""))
             ax.plot(a["b_off2"], a["f_gro"], "o-", color=f"C{k}", ms=4, label=label)
-            at = [j for j, b in enumerate(a["b_off2"]) if any(abs(b - x) < 1e-6 for x in FOUR)]
+            at = [j for j, b in enumerate(a["b_off2"]) if one_of_four(b)]
             ax.plot([a["b_off2"][j] for j in at], [a["f_gro"][j] for j in at], "s", ms=9,
                     mfc="none", color=f"C{k}")
         ax.axhline(0, color="0.7", lw=0.8)

@@ -40,22 +40,24 @@ def study_paths(args, study: str) -> tuple[Path, Path]:
     return runs, results
 
 
-def loop_seconds(run: Path) -> float:
-    """The wall time LAMMPS spent in the runs of a run directory (its log's 'Loop time')."""
+def loop_times(run: Path) -> list[tuple[float, int]]:
+    """(wall seconds, MPI ranks) of each LAMMPS run in a run directory (its log's 'Loop
+    time of T on N procs' lines)."""
     from jkrdt.rundir import LOG
 
-    return sum(float(m.group(1)) for m in
-               re.finditer(r"Loop time of ([0-9.eE+-]+)", (run / LOG).read_text()))
+    return [(float(m.group(1)), int(m.group(2))) for m in
+            re.finditer(r"Loop time of ([0-9.eE+-]+) on (\d+) procs", (run / LOG).read_text())]
+
+
+def loop_seconds(run: Path) -> float:
+    """The wall time LAMMPS spent in the runs of a run directory."""
+    return sum(seconds for seconds, _ in loop_times(run))
 
 
 def loop_ranks(run: Path) -> int:
-    """The MPI ranks that a run directory's runs used (its log's 'Loop time ... on N procs';
-    1 if it says nothing): with ``loop_seconds``, the core-seconds the run cost."""
-    from jkrdt.rundir import LOG
-
-    return max((int(m.group(1)) for m in
-                re.finditer(r"Loop time of \S+ on (\d+) procs", (run / LOG).read_text())),
-               default=1)
+    """The MPI ranks that a run directory's runs used (1 if its log says nothing): with
+    ``loop_seconds``, the core-seconds the run cost."""
+    return max((ranks for _, ranks in loop_times(run)), default=1)
 
 
 def read_committed(results: Path, ints: tuple[str, ...]) -> list[dict]:
