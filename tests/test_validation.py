@@ -200,6 +200,12 @@ def test_the_size_study_places_v_fra_and_runs_seed_2_where_it_lies(tmp_path):
         assert c["seeds_v_fra"] and all(grid[0] < v < grid[-1] for v in c["seeds_v_fra"])
     # the 3D paper's order: without friction the aggregates break at lower speed
     assert at["frictionless"]["v_fra"] < at["frictional"]["v_fra"]
+    # f_gro per offset (by_offset, 39.8 m/s for the frictionless model): its <f_gro> is
+    # eq. (1) over the same runs as the curve's at that speed, the same number
+    c = at["frictionless"]
+    o = summary["by_offset"]["frictionless"]["by_size"]["48"]
+    assert o["mean_f_gro"] == pytest.approx(c["mean_f_gro"][c["v_col"].index(39.8)], abs=1e-12)
+    assert len(o["f_gro"]) == 2 and all(-1 <= f <= 1 for f in o["f_gro"].values())
     # the committed runs.csv is the study's ledger: on a machine that lost the runs, a
     # second call runs none of them again and writes the same table and summary
     shutil.rmtree(tmp_path / "runs")

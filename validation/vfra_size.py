@@ -28,8 +28,9 @@ Writes RESULTS (default validation/vfra_size/), from every finished run below RU
 whichever call ran it and every run the committed RESULTS/runs.csv already lists:
 runs.csv (every run, with its loop time), summary.json (per size and model: <f_gro>
 against v_col, v_fra with its bracket, the compute spent; the trend of v_fra against N;
-the paper-size collisions), fig_vfra_size and fig_growth_size (<f_gro> against v_col per
-model, a line per size).
+the paper-size collisions; f_gro per offset against size, by_offset), fig_vfra_size,
+fig_growth_size (<f_gro> against v_col per model, a line per size) and fig_offsets_size
+(f_gro at each B_off^2 against N_total at one speed per model).
 
     ./run validate vfra_size                    # 2 x 5000, 2 ranks: 100 runs, hours of both cores
     ./run validate vfra_size --models "frictional, T_vis 6 ps"
@@ -275,6 +276,67 @@ def damping_effect(rows: list[dict]) -> dict:
     return out
 
 
+#: the speed at which each model's offsets are followed in size (by_offset): the paper-size
+#: collisions' speed, and for the undamped frictional model the paper's speed nearest its v_fra
+OFFSET_SPEEDS = {"frictional": 63.1, **PAPER_SIZE["speeds"]}
+
+
+def by_offset(rows: list[dict], offsets: int) -> dict:
+    """Per model, at its OFFSET_SPEEDS speed: f_gro at each B_off^2 (seeds averaged) for
+    every size that ran there, and their <f_gro> (eq. 1) where all ``offsets`` ran. It shows which collisions move
+    <f_gro> with N: a head-on one that sticks more as the aggregates grow, or the offset
+    ones."""
+    out = {}
+    for model, v in OFFSET_SPEEDS.items():
+        sizes = {}
+        for size in sorted({r["size"] for r in rows}):
+            mine = [r for r in rows if r["model"] == model and r["size"] == size and
+                    r["v_col"] == v and r["stop_reason"] in COMPLETE]
+            b2 = sorted({round(r["B_off"] ** 2, 4) for r in mine})
+            if not mine:
+                continue
+            f = {f"{b:.4f}": float(np.mean([r["growth_efficiency"] for r in mine
+                                            if round(r["B_off"] ** 2, 4) == b])) for b in b2}
+            sizes[str(int(2 * size))] = dict(
+                f_gro=f, seeds=len({r["seed"] for r in mine}),
+                mean_f_gro=(float(b_off_mean(mine, lambda r: r["growth_efficiency"]))
+                            if len(b2) == offsets else None))
+        out[model] = dict(v_col=v, by_size=sizes)
+    return out
+
+
+def offset_figure(offsets: dict, results: Path) -> list[Path]:
+    """fig_offsets_size: f_gro against N_total at each B_off^2, one panel per model at its
+    OFFSET_SPEEDS speed, with <f_gro> of the four (eq. 1) where all four ran."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 2, figsize=(11, 7.5), sharex=True, sharey=True,
+                             constrained_layout=True)
+    for ax, (model, o) in zip(axes.flat, offsets.items()):
+        n = sorted(o["by_size"], key=int)
+        for k, b in enumerate(f"{b:.4f}" for b in sorted(PAPER_SIZE["b_off2"])):
+            at = [m for m in n if b in o["by_size"][m]["f_gro"]]
+            ax.semilogx([int(m) for m in at], [o["by_size"][m]["f_gro"][b] for m in at],
+                        "o-", color=plt.cm.viridis(k / 3.5), ms=4,
+                        label=f"B_off^2 = {round(float(b) * 12)}/12")
+        at = [m for m in n if o["by_size"][m]["mean_f_gro"] is not None]
+        ax.semilogx([int(m) for m in at], [o["by_size"][m]["mean_f_gro"] for m in at],
+                    "k--", lw=2, label="<f_gro> (eq. 1)")
+        ax.axhline(0, color="0.7", lw=0.8)
+        ax.set_title(f"{model}, {o['v_col']:g} m/s (paper's v_fra {MODELS[model][2]:g})",
+                     fontsize=9)
+        ax.legend(fontsize=7)
+    for ax in axes[1]:
+        ax.set_xlabel("N_total (grains in both aggregates)")
+    for ax in axes[:, 0]:
+        ax.set_ylabel("f_gro (seeds averaged)")
+    fig.suptitle("Which collisions move <f_gro> with size: f_gro at each offset against "
+                 "N_total (ice BPCA)", fontsize=10)
+    return save(fig, results, "fig_offsets_size")
+
+
 def figure(trend: dict, paper_size: dict, results: Path) -> list[Path]:
     """fig_vfra_size: v_fra against N_total per model, the seeds' range as error bars,
     sizes whose speeds place no v_fra as open triangles at the bound they give (up: above
@@ -518,10 +580,12 @@ def main(argv=None) -> int:
     paper_size = paper_size_summary(large)
     figure(trend, paper_size, results)
     growth_figure(before + rows, paper_size, results)
+    offsets = by_offset(before + rows + large, len(plan["b_off2"]))
+    offset_figure(offsets, results)
     summary = dict(plan=plan, tolerance=TOLERANCE, ranks=args.np,
                    seconds_this_call=time.time() - t0, load=os.getloadavg()[0], sizes=sizes,
                    trend=trend, damping_effect=damping_effect(before + rows),
-                   paper_size=paper_size,
+                   paper_size=paper_size, by_offset=offsets,
                    under_way={n: {m: len(x) for m, x in by.items()}
                               for n, by in under_way.items()})
     (results / "summary.json").write_text(json.dumps(summary, indent=2, default=float) + "\n")
