@@ -312,8 +312,7 @@ def offset_figure(offsets: dict, results: Path) -> list[Path]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(2, 2, figsize=(11, 7.5), sharex=True, sharey=True,
-                             constrained_layout=True)
+    fig, axes = model_panels()
     for ax, (model, o) in zip(axes.flat, offsets.items()):
         n = sorted(o["by_size"], key=int)
         for k, b in enumerate(f"{b:.4f}" for b in sorted(PAPER_SIZE["b_off2"])):
@@ -328,13 +327,29 @@ def offset_figure(offsets: dict, results: Path) -> list[Path]:
         ax.set_title(f"{model}, {o['v_col']:g} m/s (paper's v_fra {MODELS[model][2]:g})",
                      fontsize=9)
         ax.legend(fontsize=7)
-    for ax in axes[1]:
-        ax.set_xlabel("N_total (grains in both aggregates)")
-    for ax in axes[:, 0]:
-        ax.set_ylabel("f_gro (seeds averaged)")
-    fig.suptitle("Which collisions move <f_gro> with size: f_gro at each offset against "
-                 "N_total (ice BPCA)", fontsize=10)
+    label_panels(fig, axes, "N_total (grains in both aggregates)", "f_gro (seeds averaged)",
+                 "Which collisions move <f_gro> with size: f_gro at each offset against "
+                 "N_total (ice BPCA)")
     return save(fig, results, "fig_offsets_size")
+
+
+def model_panels():
+    """A figure of one panel per model (2 x 2), the panels sharing their axes."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt.subplots(2, 2, figsize=(11, 7.5), sharex=True, sharey=True,
+                        constrained_layout=True)
+
+
+def label_panels(fig, axes, xlabel: str, ylabel: str, title: str) -> None:
+    """The x label under the bottom panels, the y label beside the left ones, the title."""
+    for ax in axes[1]:
+        ax.set_xlabel(xlabel)
+    for ax in axes[:, 0]:
+        ax.set_ylabel(ylabel)
+    fig.suptitle(title, fontsize=10)
 
 
 def figure(trend: dict, paper_size: dict, results: Path) -> list[Path]:
@@ -398,8 +413,7 @@ def growth_figure(rows: list[dict], paper_size: dict, results: Path) -> list[Pat
     sizes = sorted({r["size"] for r in rows})
     shade = {n: plt.cm.viridis(0.85 * (1 - k / max(1, len(sizes) - 1)))
              for k, n in enumerate(sizes)}
-    fig, axes = plt.subplots(2, 2, figsize=(11, 7.5), sharex=True, sharey=True,
-                             constrained_layout=True)
+    fig, axes = model_panels()
     for ax, model in zip(axes.flat, MODELS):
         for n in sizes:
             at = [r for r in rows if r["model"] == model and r["size"] == n]
@@ -423,11 +437,9 @@ def growth_figure(rows: list[dict], paper_size: dict, results: Path) -> list[Pat
         ax.set_xticks([10, 20, 40, 60, 100])
         ax.xaxis.set_major_formatter(ScalarFormatter())
         ax.xaxis.set_minor_formatter(NullFormatter())
-        ax.set_xlabel("v_col (m/s)")
-    for ax in axes[:, 0]:
-        ax.set_ylabel("<f_gro> (eq. 1, B_off^2 0-9/12)")
-    fig.suptitle("3D BPCA paper Fig. 2 against size (ice): <f_gro> of each size, seeds "
-                 "averaged per offset", fontsize=10)
+    label_panels(fig, axes, "v_col (m/s)", "<f_gro> (eq. 1, B_off^2 0-9/12)",
+                 "3D BPCA paper Fig. 2 against size (ice): <f_gro> of each size, seeds "
+                 "averaged per offset")
     return save(fig, results, "fig_growth_size")
 
 
