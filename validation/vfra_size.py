@@ -283,18 +283,18 @@ OFFSET_SPEEDS = {"frictional": 63.1, **PAPER_SIZE["speeds"]}
 
 def by_offset(rows: list[dict], offsets: int) -> dict:
     """Per model, at its OFFSET_SPEEDS speed: f_gro at each B_off^2 (seeds averaged) for
-    every size that ran there, and their <f_gro> (eq. 1) where all ``offsets`` ran. It shows which collisions move
-    <f_gro> with N: a head-on one that sticks more as the aggregates grow, or the offset
-    ones."""
+    every size that ran there, and their <f_gro> (eq. 1) where all ``offsets`` ran. It
+    shows which collisions move <f_gro> with N: a head-on one that sticks more as the
+    aggregates grow, or the offset ones."""
     out = {}
     for model, v in OFFSET_SPEEDS.items():
         sizes = {}
         for size in sorted({r["size"] for r in rows}):
             mine = [r for r in rows if r["model"] == model and r["size"] == size and
                     r["v_col"] == v and r["stop_reason"] in COMPLETE]
-            b2 = sorted({round(r["B_off"] ** 2, 4) for r in mine})
             if not mine:
                 continue
+            b2 = sorted({round(r["B_off"] ** 2, 4) for r in mine})
             f = {f"{b:.4f}": float(np.mean([r["growth_efficiency"] for r in mine
                                             if round(r["B_off"] ** 2, 4) == b])) for b in b2}
             sizes[str(int(2 * size))] = dict(
