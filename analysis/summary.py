@@ -49,14 +49,21 @@ def b_off_average(b_off2, values) -> np.ndarray:
     return (0.5 * widths * (a[1:] + a[:-1])).sum(axis=0)
 
 
-def b_off_mean(runs, value) -> np.ndarray:
-    """<A> of eq. (1) over ``runs`` (outcomes at one v_col): A = value(run) averaged over
-    the runs (seeds) of each B_off^2 first, then over B_off^2 by ``b_off_average``."""
+def b_off_groups(runs, value) -> tuple[np.ndarray, np.ndarray]:
+    """The B_off^2 values of ``runs`` (ascending) and value(run) averaged over the runs
+    (seeds) of each."""
     by_b2 = defaultdict(list)
     for o in runs:
         by_b2[round(o["B_off"] ** 2, 12)].append(value(o))
     b2 = np.array(sorted(by_b2))
-    return b_off_average(b2, np.array([np.mean(by_b2[b], axis=0) for b in b2]))
+    return b2, np.array([np.mean(by_b2[b], axis=0) for b in b2])
+
+
+def b_off_mean(runs, value) -> np.ndarray:
+    """<A> of eq. (1) over ``runs`` (outcomes at one v_col): A = value(run) averaged over
+    the runs (seeds) of each B_off^2 first (``b_off_groups``), then over B_off^2 by
+    ``b_off_average``."""
+    return b_off_average(*b_off_groups(runs, value))
 
 
 def threshold_velocity(v_col, mean_f_gro) -> float | None:

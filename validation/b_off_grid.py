@@ -75,7 +75,6 @@ def averages(rows: list[dict]) -> dict:
                                  else None))
 
 
-
 def figure(results_by: dict, results: Path) -> list[Path]:
     """fig_b_off_grid: f_gro against B_off^2, a panel per model, a line per speed, with the
     two averages of eq. (1) in the legend and the four offsets of the other studies marked."""

@@ -61,7 +61,8 @@ from bpca3d_models import FULL as SMALLER_PLAN, MODELS, model_spec
 from common import (HERE, campaign_paths, campaign_study_parser, loop_ranks, loop_seconds,
                     read_committed, run_campaigns, save, study_paths)
 from jkrdt import rundir
-from jkrdt.analysis.summary import b_off_mean, threshold_velocity
+from jkrdt.analysis.summary import (b_off_average, b_off_groups, b_off_mean,
+                                    threshold_velocity)
 from jkrdt.analysis.tables import read_csv, write_csv
 from jkrdt.stopping import COMPLETE
 
@@ -294,13 +295,11 @@ def by_offset(rows: list[dict], offsets: int) -> dict:
                     r["v_col"] == v and r["stop_reason"] in COMPLETE]
             if not mine:
                 continue
-            b2 = sorted({round(r["B_off"] ** 2, 4) for r in mine})
-            f = {f"{b:.4f}": float(np.mean([r["growth_efficiency"] for r in mine
-                                            if round(r["B_off"] ** 2, 4) == b])) for b in b2}
+            b2, f = b_off_groups(mine, lambda r: r["growth_efficiency"])
             sizes[str(int(2 * size))] = dict(
-                f_gro=f, seeds=len({r["seed"] for r in mine}),
-                mean_f_gro=(float(b_off_mean(mine, lambda r: r["growth_efficiency"]))
-                            if len(b2) == offsets else None))
+                f_gro={f"{b:.4f}": float(x) for b, x in zip(b2, f)},
+                seeds=len({r["seed"] for r in mine}),
+                mean_f_gro=float(b_off_average(b2, f)) if len(b2) == offsets else None)
         out[model] = dict(v_col=v, by_size=sizes)
     return out
 
