@@ -35,6 +35,7 @@ fig_growth_size (<f_gro> against v_col per model, a line per size) and fig_offse
     ./run validate vfra_size                    # 2 x 5000, 2 ranks: 100 runs, hours of both cores
     ./run validate vfra_size --models "frictional, T_vis 6 ps"
     ./run validate vfra_size --paper-size 0 0.5  # 2 x 50000: B_off^2 0 and 6/12 of PAPER_SIZE
+    ./run validate vfra_size --paper-size --models "frictional, T_vis 6 ps"
     ./run validate vfra_size --sizes 10000
     ./run validate vfra_size --quick            # 2 x 24 grains, two models (tests)
     ./run validate vfra_size --summary-only     # run nothing: the results of what finished
@@ -491,13 +492,16 @@ def seed_2_missing(rows: list[dict], offsets: int) -> list[float]:
             if sum(r["seed"] == SEEDS[1] and r["v_col"] == v for r in rows) < offsets]
 
 
-def run_paper_size(runs: Path, ranks: int, b_off2: list[float], ledger: list[dict]) -> None:
+def run_paper_size(runs: Path, ranks: int, b_off2: list[float], ledger: list[dict],
+                   models: list[str] | None = None) -> None:
     """The 12 collisions of PAPER_SIZE at 2 x 50000 grains, seed 1, the offsets ``b_off2``
     of each model before the next offsets of any (one campaign per model and offsets, its
-    one collision across all ``ranks``)."""
+    one collision across all ``ranks``); only ``models`` of them if given."""
     n = PAPER_SIZE["n"]
     for b2 in b_off2:
         for model, v in PAPER_SIZE["speeds"].items():
+            if models and model not in models:
+                continue
             campaign(f"v{v:g}_b2_{b2:.4f}", model, n, [v], [b2], SEEDS[0],
                      model_home(runs, n, model), ranks, ledger, ranks_per_run=ranks)
 
@@ -539,8 +543,8 @@ def main(argv=None) -> int:
     p.add_argument("--sizes", type=int, nargs="+", default=None,
                    help="grains per aggregate (default: 5000)")
     p.add_argument("--models", nargs="+", default=None, metavar="MODEL",
-                   help="run only these models at the sizes (default: all, in GRIDS' order); "
-                        "the summary takes every model's finished runs")
+                   help="run only these models at the sizes or at --paper-size (default: "
+                        "all, in GRIDS' order); the summary takes every model's finished runs")
     p.add_argument("--paper-size", nargs="*", type=float, default=None, metavar="B_OFF2",
                    help="run the 12 collisions at 2 x 50000 (PAPER_SIZE) instead of the "
                         "sizes, at these B_off^2 (default all four)")
@@ -555,11 +559,15 @@ def main(argv=None) -> int:
         p.error(f"unknown model {unknown[0]!r}: give one of {list(plan['grids'])}")
     if args.paper_size is not None and not set(args.paper_size) <= set(PAPER_SIZE["b_off2"]):
         p.error(f"--paper-size takes B_off^2 of {PAPER_SIZE['b_off2']}")
+    if args.paper_size is not None and not set(args.models or []) <= set(PAPER_SIZE["speeds"]):
+        p.error(f"--paper-size runs the models {list(PAPER_SIZE['speeds'])}: give those "
+                "to --models")
     runs, results = study_paths(args, "vfra_size")
     ledger = read_committed(results, INTS)
     t0 = time.time()
     if args.paper_size is not None and not args.summary_only:
-        run_paper_size(runs, args.np, args.paper_size or PAPER_SIZE["b_off2"], ledger)
+        run_paper_size(runs, args.np, args.paper_size or PAPER_SIZE["b_off2"], ledger,
+                       args.models)
     elif not args.summary_only:
         for n in plan["sizes"]:
             for model in args.models or plan["grids"]:
