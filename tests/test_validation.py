@@ -376,6 +376,26 @@ def test_both_seeds_run_further_when_only_seed_1_brackets_v_fra(monkeypatch, tmp
     assert both["bracket"] == [79.4, 100.0]
 
 
+def test_the_paper_size_collisions_of_the_named_models_run_alone(monkeypatch, tmp_path):
+    # --paper-size --models: the 2 x 50000 collisions of the damped models only, offset by
+    # offset in the order asked, at each model's PAPER_SIZE speed, seed 1 on all ranks
+    sys.path.insert(0, str(ROOT / "validation"))
+    try:
+        import vfra_size
+    finally:
+        sys.path.pop(0)
+    calls = []
+    monkeypatch.setattr(vfra_size, "campaign",
+                        lambda name, model, n, speeds, b_off2, seed, home, ranks, ledger,
+                        ranks_per_run: calls.append((model, n, speeds, b_off2, seed,
+                                                     ranks_per_run)))
+    damped = ["frictional, T_vis 6 ps", "frictionless, T_vis 6 ps"]
+    vfra_size.run_paper_size(tmp_path, 2, [0.25, 0.75], [], damped)
+    assert [(c[0], c[3]) for c in calls] == [(m, [b2]) for b2 in (0.25, 0.75)
+                                             for m in reversed(damped)]
+    assert all(c[1] == 50000 and c[2] == [63.1] and c[4] == 1 and c[5] == 2 for c in calls)
+
+
 def test_the_damping_effect_is_the_damped_curve_minus_its_undamped_twin():
     # per size, at the speeds both models ran: <f_gro> (eq. 1) with damping minus without;
     # the paper has the two frictional models within about 0.1 of each other
