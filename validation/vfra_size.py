@@ -530,7 +530,8 @@ def paper_size_summary(rows: list[dict]) -> dict:
             continue
         out[model] = dict(
             v_col=v, paper_v_fra=MODELS[model][2],
-            f_gro={f"{r['B_off'] ** 2:.4f}": r["growth_efficiency"] for r in mine},
+            f_gro={f"{r['B_off'] ** 2:.4f}": r["growth_efficiency"]
+                   for r in sorted(mine, key=lambda r: r["B_off"])},
             mean_f_gro=(float(b_off_mean(mine, lambda r: r["growth_efficiency"]))
                         if len(mine) == len(PAPER_SIZE["b_off2"]) else None),
             energy_error_max=max(r["energy_error"] for r in mine),
