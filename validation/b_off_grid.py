@@ -31,7 +31,7 @@ from pathlib import Path
 from bpca3d_models import model_spec
 from common import (campaign_paths, campaign_study_parser, run_campaigns, save, study_paths,
                     write_summary)
-from jkrdt.analysis.summary import b_off_groups, b_off_mean
+from jkrdt.analysis.summary import b_off_average, b_off_groups
 from jkrdt.analysis.tables import write_csv
 from jkrdt.stopping import COMPLETE
 from vfra_size import SMALLER_PLAN, TOLERANCE, model_home, outcome_rows
@@ -61,14 +61,16 @@ def growth(run: dict) -> float:
 
 
 def averages(rows: list[dict]) -> dict:
-    """f_gro per B_off^2 (seeds averaged) of one model and speed, and <f_gro> of eq. (1)
-    (``b_off_mean``) over every offset run and over the four of the other studies alone."""
+    """f_gro per B_off^2 (seeds averaged, ``b_off_groups``) of one model and speed, and
+    <f_gro> of eq. (1) (``b_off_average`` of those) over every offset run and over the four
+    of the other studies alone."""
     b2, f_gro = b_off_groups(rows, growth)
-    four = [r for r in rows if one_of_four(r["B_off"] ** 2)]
+    b2_four, f_gro_four = b_off_groups([r for r in rows if one_of_four(r["B_off"] ** 2)],
+                                       growth)
     return dict(b_off2=b2.tolist(), f_gro=f_gro.tolist(),
-                mean_f_gro_all=float(b_off_mean(rows, growth)),
-                mean_f_gro_four=(float(b_off_mean(four, growth))
-                                 if len(b_off_groups(four, growth)[0]) == len(FOUR) else None))
+                mean_f_gro_all=float(b_off_average(b2, f_gro)),
+                mean_f_gro_four=(float(b_off_average(b2_four, f_gro_four))
+                                 if len(b2_four) == len(FOUR) else None))
 
 
 def figure(results_by: dict, results: Path) -> list[Path]:
