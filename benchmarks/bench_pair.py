@@ -156,12 +156,23 @@ def per_atom_step(run: dict, natoms: int, steps: int) -> dict:
 
 
 def summarise(results: dict, sizes: list[int], configs: list[str]) -> dict:
-    """Ratios, growth with size and parallel efficiencies from the best of each cell."""
+    """Ratios, growth with size and parallel efficiencies from the best of each cell, and
+    each cell's spread over the repeats."""
     def best(config, size, style):
         runs = results.get(config, {}).get(str(size), {}).get(style)
         return min(r["loop_us_per_atom_step"] for r in runs) if runs else None
 
-    out = {"ratios": {}, "growth_with_size": {}, "efficiency": {}}
+    out = {"ratios": {}, "growth_with_size": {}, "efficiency": {}, "spread": {}}
+    # the repeats' spread: on a shared machine a set-up can be slow in whole runs (threads
+    # were 2.3x slower in about a quarter of the runs on this one), which the best hides
+    for config in configs:
+        for size in sizes:
+            for style, runs in results.get(config, {}).get(str(size), {}).items():
+                t = sorted(r["loop_us_per_atom_step"] for r in runs)
+                if style != "plain copy" and len(t) > 1:
+                    out["spread"].setdefault(f"{config} {size}x2", {})[style] = dict(
+                        best=t[0], median=t[len(t) // 2], worst=t[-1],
+                        runs_over_1_5x_best=sum(x > 1.5 * t[0] for x in t), runs=len(t))
     for config in configs:
         for size in sizes:
             cell = {}
@@ -275,7 +286,8 @@ def main(argv=None):
         results=results, **summarise(results, args.sizes, args.configs))
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(report, indent=2))
-    print(json.dumps({k: report[k] for k in ("ratios", "growth_with_size", "efficiency")},
+    print(json.dumps({k: report[k] for k in ("ratios", "growth_with_size", "efficiency",
+                                             "spread")},
                      indent=2))
 
 
