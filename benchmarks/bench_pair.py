@@ -34,6 +34,7 @@ import os
 import platform
 import re
 import shutil
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -171,7 +172,7 @@ def summarise(results: dict, sizes: list[int], configs: list[str]) -> dict:
                 t = sorted(r["loop_us_per_atom_step"] for r in runs)
                 if style != "plain copy" and len(t) > 1:
                     out["spread"].setdefault(f"{config} {size}x2", {})[style] = dict(
-                        best=t[0], median=t[len(t) // 2], worst=t[-1],
+                        best=t[0], median=statistics.median(t), worst=t[-1],
                         runs_over_1_5x_best=sum(x > 1.5 * t[0] for x in t), runs=len(t))
     for config in configs:
         for size in sizes:
