@@ -326,6 +326,7 @@ void FixJKRDTContacts::to_slots(const NeighList *list)
     }
   slot_list = list;
   slot_build = neighbor->lastcall;
+  slot_generation++;
   // the atoms as the list saw them: a fix that migrates atoms before this fix's
   // pre_exchange (fix balance rcb) may append arrivals, which take the ghosts' places,
   // before the rows are written back

@@ -108,6 +108,7 @@ class FixJKRDTContacts : public Fix {
   void to_slots(const class NeighList *list);
   void to_rows();
   bool slots_follow(const class NeighList *list) const;
+  bigint slots_made() const { return slot_generation; }    // changes when the slots do
   void rows_changed() { rows_stale = true; }
   unsigned char *bonded;     // per slot: 1 = a bonded contact
   double *slot_values;       // per slot: dnum values
@@ -164,6 +165,7 @@ class FixJKRDTContacts : public Fix {
   int maxfirst;                     // ilist entries allocated
   const class NeighList *slot_list; // the list the slots follow ...
   bigint slot_build;                // ... as built at this step (neighbor->lastcall)
+  bigint slot_generation = 0;       // to_slots() calls so far
   bool rows_stale;                  // the slots hold state the rows do not
   int slot_nlocal;                  // owned atoms when the slots were filled ...
   std::vector<tagint> slot_tag;     // ... and the IDs of all atoms then, owned and ghost

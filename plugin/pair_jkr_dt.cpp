@@ -137,5 +137,6 @@ bool PairJKRDT::bonded_contact(int i, int j, ContactView &view) const
 double PairJKRDT::memory_usage()
 {
   return Pair::memory_usage() +
-      (input.size() * sizeof(Input) + param.size() * sizeof(Param));
+      (input.size() * sizeof(Input) + param.size() * sizeof(Param) +
+       slot_pair.capacity() * sizeof(SlotPair));
 }

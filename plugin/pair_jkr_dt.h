@@ -233,6 +233,16 @@ class PairJKRDT : public Pair {
   bigint thread_of_build = -1;        // ... for the list of this build
   int thread_of_threads = 0;          // ... and this many threads
   std::vector<Accumulator> accumulators;
+  // the list's pairs in slot order, oriented as evaluated (follow_slots), so that the
+  // distance test runs over one flat array: no loop per atom, whose exit (after ~1
+  // neighbor, a varying number) the CPU mispredicts, and no IDs looked up per pair
+  struct SlotPair {
+    int p, q;    // particles 1 and 2
+  };
+  std::vector<SlotPair> slot_pair;
+  bigint slot_pair_made = -1;         // the contact fix's slots_made() they follow ...
+  bool slot_pair_oriented = false;    // ... and whether by ID (any_tangential)
+  void follow_slots();
   int threads_logged;          // threads per rank last written to the log
   void fill_pvector(double upot, const double *utan, double contacts);
 };

@@ -61,6 +61,8 @@ void PairJKRDT::compute(int eflag, int vflag)
   }
   Contacts &C = *fix_contacts;
   if (!C.slots_follow(list)) C.to_slots(list);    // a list built without post_neighbor
+  if (slot_pair_made != C.slots_made() || slot_pair_oriented != any_tangential)
+    follow_slots();
 
   const int inum = list->inum;
   const bool tally_atoms = eflag_atom || vflag_atom;
@@ -162,6 +164,35 @@ void PairJKRDT::compute(int eflag, int vflag)
 }
 
 /* ----------------------------------------------------------------------
+   the list's pairs in the contact fix's slot order (ilist, then each
+   atom's neighbors), each in the orientation the loop evaluates it in: with
+   tangential channels particle 1 is the smaller ID (the state is kept for
+   that orientation, and both ranks of a pair with a ghost atom then do the
+   same arithmetic), else the list's atom i. IDs change only where the list
+   is built anew, so the orientation holds until the slots change.
+------------------------------------------------------------------------- */
+
+void PairJKRDT::follow_slots()
+{
+  const Contacts &C = *fix_contacts;
+  const tagint *tag = atom->tag;
+  const int inum = list->inum;
+  const int *ilist = list->ilist, *numneigh = list->numneigh;
+  int **firstneigh = list->firstneigh;
+  slot_pair.resize(C.slot_first[inum]);
+  for (int ii = 0; ii < inum; ii++) {
+    const int i = ilist[ii];
+    SlotPair *to = slot_pair.data() + C.slot_first[ii];
+    for (int jj = 0; jj < numneigh[i]; jj++) {
+      const int j = firstneigh[i][jj] & NEIGHMASK;
+      to[jj] = any_tangential && tag[j] < tag[i] ? SlotPair{j, i} : SlotPair{i, j};
+    }
+  }
+  slot_pair_made = C.slots_made();
+  slot_pair_oriented = any_tangential;
+}
+
+/* ----------------------------------------------------------------------
    where the pair loop finds a contact's constants (contact_constants), as
    the radii are now: one set for the scene when every type pair present
    has the same constants and each type one radius, one per type pair when
@@ -193,10 +224,11 @@ PairJKRDT::ConstantsBy PairJKRDT::constants_by()
    some type pair has a tangential channel.
 
    Orientation. The tangential state is kept for particle 1 = the smaller
-   ID, so a contact with a channel is evaluated in that orientation. The
-   normal force needs no orientation: swapping the atoms negates d12 and
-   v12 exactly and leaves every product the same, so without channels the
-   pair is taken as the list gives it and the same bits result.
+   ID, so a contact with a channel is evaluated in that orientation, as
+   follow_slots() stores it. The normal force needs no orientation: swapping
+   the atoms negates d12 and v12 exactly and leaves every product the same,
+   so without channels the pair is taken as the list gives it and the same
+   bits result.
 ------------------------------------------------------------------------- */
 
 template <bool TANGENTIAL>
@@ -228,9 +260,6 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
   const JKRDT::StateLayout layout = C.layout();
   unsigned char *const bonded_slot = C.bonded;
   double *const slot_values = C.slot_values;
-  const int *ilist = list->ilist;
-  const int *numneigh = list->numneigh;
-  int **firstneigh = list->firstneigh;
 
   const JKRDT::ContactConstants *const scene_K =
       by == BY_SCENE ? &type_constants[scene_pair] : nullptr;
@@ -288,32 +317,24 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
     Done done[BLOCK];
   } B;
   JKRDT::TangentialLanes<BLOCK> TL;
-  int ii = ii_from, jj = 0;
-  while (ii < ii_to) {
+  const SlotPair *const pairs = slot_pair.data();
+  const int s_to = C.slot_first[ii_to];
+  int s = C.slot_first[ii_from];
+  while (s < s_to) {
     int n = 0;
-    while (ii < ii_to && n < BLOCK) {
-      const int i = ilist[ii];
-      const int *jlist = firstneigh[i];
-      const int jnum = numneigh[i];
-      const V3 xi = JKRDT::vec(x + 3 * i);
-      for (int s = C.slot_first[ii] + jj; jj < jnum && n < BLOCK; jj++, s++) {
-        const int j = jlist[jj] & NEIGHMASK;
-        const V3 d12 = xi - JKRDT::vec(x + 3 * j);
-        const double rsq = JKRDT::dot(d12, d12);
-        const double radsum = by == BY_SCENE ? scene_K->radsum : radius[i] + radius[j];
-        if (!bonded_slot[s] && rsq > radsum * radsum) continue;
-        B.i[n] = i;
-        B.j[n] = j;
-        B.slot[n] = s;
-        B.d12[n] = d12;
-        B.rsq[n] = rsq;
-        B.radsum[n] = radsum;
-        n++;
-      }
-      if (jj == jnum) {
-        ii++;
-        jj = 0;
-      }
+    for (; s < s_to && n < BLOCK; s++) {
+      const int i = pairs[s].p, j = pairs[s].q;
+      const V3 d12 = JKRDT::vec(x + 3 * i) - JKRDT::vec(x + 3 * j);
+      const double rsq = JKRDT::dot(d12, d12);
+      const double radsum = by == BY_SCENE ? scene_K->radsum : radius[i] + radius[j];
+      if (!bonded_slot[s] && rsq > radsum * radsum) continue;
+      B.i[n] = i;
+      B.j[n] = j;
+      B.slot[n] = s;
+      B.d12[n] = d12;
+      B.rsq[n] = rsq;
+      B.radsum[n] = radsum;
+      n++;
     }
     for (int k = 0; k < n; k++) B.r[k] = std::sqrt(B.rsq[k]);
     for (int k = 0; k < n; k++) B.rinv[k] = 1.0 / B.r[k];
@@ -341,17 +362,12 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
     // grows and its time did too)
     auto evaluate = [&](auto plain, int k, Done &o) __attribute__((always_inline)) -> Eval {
       constexpr bool PLAIN = decltype(plain)::value;
-      const int i = B.i[k], j = B.j[k], s = B.slot[k];
+      // 2. the pair as follow_slots() stored it (p = particle 1 where that matters) and its
+      // constants
+      const int p = B.i[k], q = B.j[k], s = B.slot[k];
       const bool bonded = PLAIN || bonded_slot[s];
-      V3 d12 = B.d12[k];
+      const V3 d12 = B.d12[k];
       const double radsum = B.radsum[k];
-
-      // 2. orientation (p = particle 1) and constants
-      int p = i, q = j;
-      if (TANGENTIAL && tag[j] < tag[i]) {
-        std::swap(p, q);
-        d12 = -d12;
-      }
       const JKRDT::ContactConstants &K = constants(p, q);
 
       // a grain of a fragment that has left for good meets nothing, and its own contacts
