@@ -307,8 +307,11 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
   // 1. the distance test, over a block of the list's pairs at a time: the pairs in
   // contact or touching are kept with their separation, and their r and 1/r are then
   // taken for the whole block at once: square roots and divisions that do not wait for
-  // one another, instead of heading each pair's chain of dependent steps
-  constexpr int BLOCK = 64;
+  // one another, instead of heading each pair's chain of dependent steps. 16 pairs: a
+  // block's scratch (these arrays, the lanes' inputs, each contact's motion and result)
+  // then stays in a 48 KB L1 cache between its passes; at 64 it did not, and the full
+  // model's loop missed L1 on about 6 writes per pair (callgrind, README "Speed")
+  constexpr int BLOCK = 16;
   struct {
     int i[BLOCK], j[BLOCK], slot[BLOCK];
     V3 d12[BLOCK];
