@@ -474,19 +474,20 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
         for (int side = 0; side < 2; side++) {
           const int a = side ? q : p;
           if (!PLAIN && a >= nlocal) continue;
-          double *fa, *ta, *la;
+          double *fa, *ta, *far_loss = nullptr;
           if (PLAIN || !thread_of_atom || thread_of_atom[a] == me) {
             fa = f + 3 * a;
             ta = tq + 3 * a;
-            la = ledger[a];
           } else {
             acc.far.push_back(FarLoad{a, {0, 0, 0}, {0, 0, 0}, {0, 0, 0, 0, 0}});
             fa = acc.far.back().f;
             ta = acc.far.back().torque;
-            la = acc.far.back().loss;
+            far_loss = acc.far.back().loss;
           }
-          if (lossy && (PLAIN || !o.setup))
+          if (lossy && (PLAIN || !o.setup)) {    // the atom's ledger row only when it books
+            double *la = far_loss ? far_loss : ledger[a];
             for (int l = 0; l < nloss; l++) la[l] += 0.5 * out.loss[l];
+          }
           if (broken) continue;
           const V3 fa_add = side ? -fp : fp;
           fa[0] += fa_add.x;
