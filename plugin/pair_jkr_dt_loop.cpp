@@ -52,6 +52,39 @@
 using namespace LAMMPS_NS;
 using Contacts = FixJKRDTContacts;
 
+namespace {
+// a lean pair's loads on its two atoms, in the order deliver() adds them: F_1 on atom p and
+// -F_1 on q in the flat force array; M_1 and M_2 in the torques (with channels); half of
+// each of the step's first nloss losses in each atom's ledger row (when it has any)
+inline void add_pair_force(int p, int q, const JKRDT::V3 &F1, double *f)
+{
+  double *fp = f + 3 * p, *fq = f + 3 * q;
+  fp[0] += F1.x;
+  fp[1] += F1.y;
+  fp[2] += F1.z;
+  fq[0] += -F1.x;
+  fq[1] += -F1.y;
+  fq[2] += -F1.z;
+}
+inline void add_pair_torques(int p, int q, const JKRDT::V3 &M1, const JKRDT::V3 &M2, double *t)
+{
+  double *tp = t + 3 * p, *tq = t + 3 * q;
+  tp[0] += M1.x;
+  tp[1] += M1.y;
+  tp[2] += M1.z;
+  tq[0] += M2.x;
+  tq[1] += M2.y;
+  tq[2] += M2.z;
+}
+inline void book_pair_losses(int p, int q, const double *loss, int nloss, double *const *rows)
+{
+  for (int side = 0; side < 2; side++) {
+    double *la = rows[side ? q : p];
+    for (int l = 0; l < nloss; l++) la[l] += 0.5 * loss[l];
+  }
+}
+}    // namespace
+
 void PairJKRDT::compute(int eflag, int vflag)
 {
   ev_init(eflag, vflag);
@@ -221,7 +254,11 @@ PairJKRDT::ConstantsBy PairJKRDT::constants_by()
    pair: the distance test (all that a pair out of contact costs), the
    orientation and constants, the motion and its guards, contact_step(),
    and the loads and dissipation on this thread's owned atoms. TANGENTIAL:
-   some type pair has a tangential channel.
+   some type pair has a tangential channel. Most pairs in most steps are a
+   contact that held between two atoms of this thread (LEAN, below): they
+   take the same arithmetic on a short path out of line (lean_run(), or
+   lean_put() and lean_deliver() around the lanes), which leaves the pair it
+   cannot finish to the five steps.
 
    Orientation. The tangential state is kept for particle 1 = the smaller
    ID, so a contact with a channel is evaluated in that orientation, as
@@ -247,7 +284,6 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
   const int departed = departed_bit;
   const int nlocal = atom->nlocal;
   const bool run_setup = update->setupflag;
-  const bool plain_steps = !run_setup && !tally_atoms;    // PLAIN pairs may occur (below)
   const double dt = update->dt;
   const double half_skin = 0.5 * neighbor->skin;
   double *const f = atom->f[0], *const tq = atom->torque[0];    // flat, as x
@@ -292,7 +328,7 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
     hand_over();
   };
   // a pair of the block: where evaluate() leaves it for deliver()
-  enum class Eval { SKIP, DONE, TROUBLE };
+  enum class Eval { SKIP, DONE, TROUBLE, LEAN };    // LEAN: lean_put() took it
   struct Done {
     int p, q, s, owned;
     bool parked, setup;
@@ -320,6 +356,124 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
     Done done[BLOCK];
   } B;
   JKRDT::TangentialLanes<BLOCK> TL;
+
+  // the common frictionless step (LEAN): a contact that held at the last step between two
+  // atoms this thread owns, none departed, in a step that is no set-up and sums no energy
+  // or virial. lean_run() takes a run [k0, k1) of such pairs of the block out of line, so
+  // that the few values it needs stay in registers (inlined in the loop, the step shared
+  // some 40 live values and reloaded them from the stack). It stops at a pair it cannot
+  // finish (a guard, a contact that breaks: returns its k, nothing of it applied, for
+  // evaluate() and deliver(), which give the same bits) and at a force that is not finite
+  // (returns -(k + 1)); else it returns k1
+  const bool lean_steps = !TANGENTIAL && !run_setup && !tally_atoms && !eflag && !vflag_either;
+  auto lean_run = [&](int k0, int k1) __attribute__((noinline)) -> int {
+    // the values the run reads, in locals: a store to a force may not alias them
+    const double *const vv = v;
+    double *const ff = f;
+    double **const rows = ledger;
+    const double step_dt = dt, skin_half = half_skin;
+    const JKRDT::StateLayout L = layout;
+    const JKRDT::ContactConstants *const K_scene = scene_K;    // else per pair (constants)
+    double smax = step_max;
+    bigint ends = 0;
+    int k = k0;
+    for (; k < k1; k++) {
+      const int p = B.i[k], q = B.j[k];
+      const JKRDT::ContactConstants &K = K_scene ? *K_scene : constants(p, q);
+      const double r = B.r[k];
+      const double delta = B.radsum[k] - r;    // eq. (3)
+      if (!std::isfinite(delta) || r == 0.0 || delta < -K.S.delta_c) break;
+      const V3 d12 = B.d12[k];
+      const double rinv = B.rinv[k];
+      const double vn = JKRDT::dot(JKRDT::vec(vv + 3 * p) - JKRDT::vec(vv + 3 * q), d12) * rinv;
+      const double step = std::fabs(vn) * step_dt;
+      if (step > skin_half) break;
+      smax = std::max(smax, step * K.inv_delta_c);
+      double *state = L.dnum ? slot_values + (bigint) B.slot[k] * L.dnum : nullptr;
+      JKRDT::NormalResult nr;
+      JKRDT::normal_step(K, L, vn, delta, step_dt, false, false, false, state, nr, B.y_near[k]);
+      const V3 F1 = (nr.f * rinv) * d12;
+      if (!std::isfinite(F1.x + F1.y + F1.z)) {
+        step_max = smax;
+        contact_ends += ends;
+        return -(k + 1);
+      }
+      if (nr.lossy) {    // damped: F_D's work
+        static_assert(JKRDT::LOSS_FORM_BREAK == 0 && JKRDT::LOSS_DAMPING == 1, "ledger order");
+        const double loss[] = {nr.loss_event, nr.loss_damping};
+        book_pair_losses(p, q, loss, 2, rows);
+      }
+      add_pair_force(p, q, F1, ff);
+      ends += 2;
+    }
+    step_max = smax;
+    contact_ends += ends;
+    return k;
+  };
+
+  // with channels, on the lanes' path: lean_put() takes a run of such pairs to the lanes
+  // (contact_normal_part, then TangentialLanes::put) and lean_deliver() adds their loads
+  // after the lanes' step. lean_put() stops, nothing of the pair applied, at a pair that
+  // needs a guard, breaks or has no pointers yet, and returns its k
+  const bool lean_lanes = lanes && !run_setup && !tally_atoms && !eflag && !vflag_either;
+  auto lean_put = [&](int k0, int k1, int &nlane) __attribute__((noinline)) -> int {
+    const double *const vv = v, *const ww = omega;
+    const double step_dt = dt, skin_half = half_skin;
+    const JKRDT::StateLayout L = layout;
+    const JKRDT::ContactConstants &K = *scene_K;
+    double smax = step_max;
+    int k = k0;
+    for (; k < k1; k++) {
+      const int p = B.i[k], q = B.j[k], s = B.slot[k];
+      const double r = B.r[k];
+      const double delta = B.radsum[k] - r;    // eq. (3)
+      if (!std::isfinite(delta) || r == 0.0 || delta < -K.S.delta_c) break;
+      double *state = slot_values + (bigint) s * L.dnum;
+      if (!JKRDT::traced(state, L)) break;
+      Done &o = B.done[k];
+      JKRDT::ContactMotion &m = o.m;
+      m.d12 = B.d12[k];
+      m.r = r;
+      m.rinv = B.rinv[k];
+      m.v12 = JKRDT::vec(vv + 3 * p) - JKRDT::vec(vv + 3 * q);
+      m.w1 = JKRDT::vec(ww + 3 * p);
+      m.w2 = JKRDT::vec(ww + 3 * q);
+      m.vn = JKRDT::dot(m.v12, m.d12) * m.rinv;
+      const double step = std::fabs(m.vn) * step_dt;
+      if (step > skin_half) break;
+      smax = std::max(smax, step * K.inv_delta_c);
+      JKRDT::contact_normal_part(K, L, m, delta, step_dt, false, false, false, state, o.out,
+                                 B.y_near[k]);
+      TL.put(nlane++, m, state, L, o.out);
+      o.p = p;
+      o.q = q;
+      B.eval[k] = Eval::LEAN;
+    }
+    step_max = smax;
+    return k;
+  };
+  // the loads of lean_put()'s pairs [k0, k1) as deliver() adds them; -(k + 1) where a force
+  // is not finite, else k1
+  auto lean_deliver = [&](int k0, int k1) __attribute__((noinline)) -> int {
+    double *const ff = f, *const tt = tq;
+    double **const rows = ledger;
+    bigint ends = 0;
+    int k = k0;
+    for (; k < k1; k++) {
+      const Done &o = B.done[k];
+      const int p = o.p, q = o.q;
+      const JKRDT::ContactResult &out = o.out;
+      const V3 F1 = out.F1;
+      if (!std::isfinite(F1.x + F1.y + F1.z)) break;
+      if (out.lossy) book_pair_losses(p, q, out.loss, JKRDT::NLOSS, rows);
+      add_pair_force(p, q, F1, ff);
+      add_pair_torques(p, q, out.M1, out.M2, tt);
+      ends += 2;
+    }
+    contact_ends += ends;
+    return k < k1 ? -(k + 1) : k1;
+  };
+
   const SlotPair *const pairs = slot_pair.data();
   const int s_to = C.slot_first[ii_to];
   int s = C.slot_first[ii_from];
@@ -357,31 +511,24 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
     // is taken four at a time in between, and every pair of the block is delivered after
     // it, in list order, as without it
     int nlane = 0;
-    // evaluate() and deliver() are compiled for any pair and, without channels, also
-    // (PLAIN) for the common one: a contact that held at the last step between two atoms
-    // this thread owns, none departed, in a step that is no set-up and tallies no per-atom
-    // values; there the bookkeeping for the others folds away (frictionless, 2 x 2500:
-    // 11 % fewer instructions in the loop, 4 % less time; with channels the loop's code
-    // grows and its time did too)
-    auto evaluate = [&](auto plain, int k, Done &o) __attribute__((always_inline)) -> Eval {
-      constexpr bool PLAIN = decltype(plain)::value;
+    auto evaluate = [&](int k, Done &o) __attribute__((always_inline)) -> Eval {
       // 2. the pair as follow_slots() stored it (p = particle 1 where that matters) and its
       // constants
       const int p = B.i[k], q = B.j[k], s = B.slot[k];
-      const bool bonded = PLAIN || bonded_slot[s];
+      const bool bonded = bonded_slot[s];
       const V3 d12 = B.d12[k];
       const double radsum = B.radsum[k];
       const JKRDT::ContactConstants &K = constants(p, q);
 
       // a grain of a fragment that has left for good meets nothing, and its own contacts
       // stand still: they are only evaluated, as a set-up does, for their potential energy
-      const int owned = PLAIN ? 2 : (p < nlocal) + (q < nlocal);    // half per owned atom
-      const bool parked = !PLAIN && departed && ((mask[p] | mask[q]) & departed);
+      const int owned = (p < nlocal) + (q < nlocal);    // half per owned atom
+      const bool parked = departed && ((mask[p] | mask[q]) & departed);
       if (parked && !(bonded && eflag)) {
         if (bonded) contact_ends += owned;
         return Eval::SKIP;
       }
-      const bool setup = !PLAIN && (run_setup || parked);
+      const bool setup = run_setup || parked;
       o.p = p;
       o.q = q;
       o.s = s;
@@ -455,8 +602,7 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
       return Eval::DONE;
     };
 
-    auto deliver = [&](auto plain, const Done &o) __attribute__((always_inline)) -> bool {
-      constexpr bool PLAIN = decltype(plain)::value;
+    auto deliver = [&](const Done &o) __attribute__((always_inline)) -> bool {
       const int p = o.p, q = o.q;
       const JKRDT::ContactResult &out = o.out;
       const V3 &fp = out.F1, &d12 = o.d12;
@@ -470,12 +616,12 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
 
       // 5. force on p: normal (eq. 5 and A.5) plus sliding (eq. 14), -force on q; torques
       // eqs. (17), (23), (27); half of the step's dissipation to each owned atom
-      if (PLAIN || !o.parked)
+      if (!o.parked)
         for (int side = 0; side < 2; side++) {
           const int a = side ? q : p;
-          if (!PLAIN && a >= nlocal) continue;
+          if (a >= nlocal) continue;
           double *fa, *ta, *far_loss = nullptr;
-          if (PLAIN || !thread_of_atom || thread_of_atom[a] == me) {
+          if (!thread_of_atom || thread_of_atom[a] == me) {
             fa = f + 3 * a;
             ta = tq + 3 * a;
           } else {
@@ -484,7 +630,7 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
             ta = acc.far.back().torque;
             far_loss = acc.far.back().loss;
           }
-          if (lossy && (PLAIN || !o.setup)) {    // the atom's ledger row only when it books
+          if (lossy && !o.setup) {    // the atom's ledger row only when it books
             double *la = far_loss ? far_loss : ledger[a];
             for (int l = 0; l < nloss; l++) la[l] += 0.5 * out.loss[l];
           }
@@ -503,16 +649,16 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
       if (broken) return true;
 
       // energy and virial
-      contact_ends += PLAIN ? 2 : o.owned;
+      contact_ends += o.owned;
       if (!eflag && !vflag_either) return true;
-      const double share = PLAIN ? 1.0 : 0.5 * o.owned;
+      const double share = 0.5 * o.owned;
       const double u = TANGENTIAL ? out.U_n + out.U[0] + out.U[1] + out.U[2] : out.U_n;
       if (eflag) {
         acc.upot += share * out.U_n;
         if (TANGENTIAL)
           for (int ch = 0; ch < JKRDT::NCHANNEL; ch++) acc.utan[ch] += share * out.U[ch];
       }
-      if (!PLAIN && tally_atoms) {
+      if (tally_atoms) {
         ev_tally_xyz(p, q, nlocal, 0, u, 0.0, fp.x, fp.y, fp.z, d12.x, d12.y, d12.z);
         return true;
       }
@@ -529,39 +675,72 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
       return true;
     };
 
-    const std::true_type plain;
-    const std::false_type any;
-    auto is_plain = [&](int k) __attribute__((always_inline)) {
-      if constexpr (TANGENTIAL) return false;
+    // a LEAN pair: bonded, both atoms this thread's (the list's atom i is; with channels the
+    // pair may be stored the other way round), none departed
+    auto lean = [&](int k) __attribute__((always_inline)) {
       const int i = B.i[k], j = B.j[k];
-      return plain_steps && bonded_slot[B.slot[k]] && j < nlocal &&
-          !(departed && ((mask[i] | mask[j]) & departed)) &&
-          (!thread_of_atom || thread_of_atom[j] == me);
+      if (!bonded_slot[B.slot[k]] || j >= nlocal || (TANGENTIAL && i >= nlocal) ||
+          (departed && ((mask[i] | mask[j]) & departed)))
+        return false;
+      return !thread_of_atom ||
+          (thread_of_atom[j] == me && (!TANGENTIAL || thread_of_atom[i] == me));
     };
     if constexpr (TANGENTIAL) {
       if (lanes) {
         for (int k = 0; k < n; k++) {
-          B.eval[k] = evaluate(any, k, B.done[k]);
+          if (lean_lanes && lean(k)) {
+            int k1 = k + 1;
+            while (k1 < n && lean(k1)) k1++;
+            const int stop = lean_put(k, k1, nlane);
+            if (stop == k1) {
+              k = k1 - 1;
+              continue;
+            }
+            k = stop;    // the pair lean_put() left, taken below
+          }
+          B.eval[k] = evaluate(k, B.done[k]);
           if (B.eval[k] == Eval::TROUBLE) return;
         }
         // 4b. the tangential step of the contacts on its common path, four at a time
         TL.step(nlane, *scene_K, layout, dt, eflag);
-        for (int k = 0; k < n; k++)
-          if (B.eval[k] == Eval::DONE && !deliver(any, B.done[k])) return;
+        for (int k = 0; k < n; k++) {
+          if (B.eval[k] == Eval::LEAN) {
+            int k1 = k + 1;
+            while (k1 < n && B.eval[k1] == Eval::LEAN) k1++;
+            const int stop = lean_deliver(k, k1);
+            if (stop < 0) {
+              trouble(Trouble::NOT_FINITE, B.done[-stop - 1].p, B.done[-stop - 1].q, 0, 0,
+                      *scene_K);
+              return;
+            }
+            k = k1 - 1;
+            continue;
+          }
+          if (B.eval[k] == Eval::DONE && !deliver(B.done[k])) return;
+        }
         continue;
       }
     }
     for (int k = 0; k < n; k++) {
-      Done o;
-      if (is_plain(k)) {
-        const Eval e = evaluate(plain, k, o);
-        if (e == Eval::TROUBLE) return;
-        if (e == Eval::DONE && !deliver(plain, o)) return;
-        continue;
+      if (lean_steps && lean(k)) {
+        int k1 = k + 1;
+        while (k1 < n && lean(k1)) k1++;
+        const int stop = lean_run(k, k1);
+        if (stop < 0) {
+          trouble(Trouble::NOT_FINITE, B.i[-stop - 1], B.j[-stop - 1], 0, 0,
+                  constants(B.i[-stop - 1], B.j[-stop - 1]));
+          return;
+        }
+        if (stop == k1) {
+          k = k1 - 1;
+          continue;
+        }
+        k = stop;    // the pair lean_run() left, taken below
       }
-      const Eval e = evaluate(any, k, o);
+      Done o;
+      const Eval e = evaluate(k, o);
       if (e == Eval::TROUBLE) return;
-      if (e == Eval::DONE && !deliver(any, o)) return;
+      if (e == Eval::DONE && !deliver(o)) return;
     }
   }
   hand_over();
