@@ -209,8 +209,9 @@ class PairJKRDT : public Pair {
     Trouble trouble;                // the first problem met; the thread stops there
   };
   // the pair loop, written once and compiled twice: for any x86-64 (SSE2) and for CPUs
-  // with AVX2, chosen when the run starts (pair_style ... kernel auto|portable)
-  template <bool TANGENTIAL>
+  // with AVX2 (AVX2: the instantiation its out-of-line parts are compiled for too), chosen
+  // when the run starts (pair_style ... kernel auto|portable)
+  template <bool TANGENTIAL, bool AVX2>
   [[gnu::always_inline]] inline void pair_loop(int ii_from, int ii_to, int eflag,
                                                bool tally_atoms, ConstantsBy by,
                                                Accumulator &acc);
