@@ -20,12 +20,13 @@ import numpy as np
 
 from jkrdt import rundir
 from jkrdt.rundir import read_thermo, run_status
-from jkrdt.ledger import CHANNELS, energy_budget, energy_error
+from jkrdt.ledger import CHANNELS, contact_events, energy_budget, energy_error
 from jkrdt.stopping import ENERGY_WARN, STOP_WORDS
 
 from .dumps import atoms_universe
 from .outcome import CollisionOutcome, energy_scalings, from_checks
 from .plots import energy_partition, outcome, timeline
+from .summary import diagnostics
 from .tables import read_csv, write_csv
 
 
@@ -136,6 +137,11 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
                    dissipated_fraction=float(budget["dissipated"][end] / e_imp),
                    dissipated_by_channel={name: float(budget[name][end] / e_imp)
                                           for name in CHANNELS})
+        # N_con, N_cut (3D BPCA paper, App. C.2) at the analysed end; the bonded contacts
+        # then less those at the start are N_con - N_cut exactly
+        events = contact_events({k: v[:end + 1] for k, v in thermo.items()})
+        if events is not None:
+            out.update(events)
     write_csv(run / rundir.FRAMES, rows)
     if plots:
         title = (f"{mat.name} {scene.kind.upper()} {n_tar}+{n_pro}, "
@@ -156,6 +162,7 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
             pictures += energy_partition(run / "energy", thermo["Time"], budget, meta["E_imp"],
                                          title)
         out["pictures"] = [str(p) for p in pictures]
+    out["diagnostics"] = diagnostics(out)
     rundir.write_outcome(run, out)
     return out
 
@@ -191,6 +198,11 @@ def summary_text(out: dict) -> str:
         lines.append(f"dissipated / E_imp          {out['dissipated_fraction']:.3f}  ("
                      + ", ".join(f"{k} {v:.3f}" for k, v in out["dissipated_by_channel"].items())
                      + ")")
+    if out.get("N_con") is not None:
+        lines.append(f"contacts made / cut         N_con {out['N_con']:.0f}, N_cut "
+                     f"{out['N_cut']:.0f}  ({out['N_con'] / out['n_total']:.2f} and "
+                     f"{out['N_cut'] / out['n_total']:.2f} N_tot; bonded "
+                     f"{out['contacts_start']:.0f} -> {out['contacts_end']:.0f})")
     if "potential_change" in out:
         lines.append(f"energy partition / E_imp    kinetic {out['kinetic_left']:.3f} + potential "
                      f"change {out['potential_change']:+.3f} + dissipated "

@@ -4,8 +4,11 @@
 
 is integrated with the trapezoid rule over the grid of B_off^2 values the campaign ran
 (the paper's grid is 0, 1/12, ..., 1, on which the rule is exact for A linear in
-B_off^2); A is held at its end values outside the grid. v_fra is where <f_gro>
-crosses 0, interpolated linearly in log v_col between the grid velocities.
+B_off^2); A is held at its end values outside the grid, except on the paper's grid less
+its grazing end (``jkrdt.protocol``), where B_off^2 = 1 takes A's no-collision value.
+v_fra is where <f_gro> crosses 0, interpolated linearly in log v_col between the grid
+velocities. With two or more seeds, each seed's <f_gro> and v_fra are taken on their own
+too, and their mean and standard error are the scatter the campaign reports.
 """
 
 from __future__ import annotations
@@ -16,23 +19,32 @@ from pathlib import Path
 
 import numpy as np
 
-from jkrdt import rundir
+from jkrdt import protocol, rundir
 from jkrdt.rundir import write_json
 from jkrdt.stopping import COMPLETE
 
 from . import plots
 from .tables import write_csv
 
+#: N of the paper's N_cum(<= N) that every run's diagnostics carry (3D BPCA paper, Fig. 3)
+N_CUM_AT = (1, 10, 100, 1000)
+#: the 3D BPCA paper's diagnostics of one collision (its App. C and Fig. 3), as
+#: ``diagnostics`` names them: contacts made and cut (Figs. C.3, C.4), the energy
+#: dissipated in all, by making and breaking contacts, by damping (Figs. C.1, C.2) and by
+#: the tangential channels, all over E_imp; N_cum(<= N) at N_CUM_AT
+DIAGNOSTICS = ["N_con", "N_cut", "E_dis_tot", "E_dis_c", "E_dis_v", "E_dis_sliding",
+               "E_dis_rolling", "E_dis_twisting", *(f"N_cum_{n}" for n in N_CUM_AT)]
 SCALARS = ["model", "material", "xi_crit", "tvis", "kind", "dimension", "N_tar", "N_pro",
            "v_col", "B_off", "seed", "radius", "E_imp", "n_k", "E_imp_over_nk_Eroll",
            "E_imp_over_nk_Ebreak", "step", "n_total", "n_largest", "n_second", "n_fragments",
            "growth_efficiency", "gyration_radius_largest", "contacts_per_particle",
            "dissipated_fraction", "energy_error", "energy_warning", "stop_reason", "stop_step",
-           "kinetic_left", "problem", "run"]
+           "kinetic_left", *DIAGNOSTICS, "problem", "run"]
 
 
-def b_off_average(b_off2, values) -> np.ndarray:
-    """<A> of eq. (1) from values of A (along axis 0) at the given B_off^2."""
+def b_off_average(b_off2, values, grazing=None) -> np.ndarray:
+    """<A> of eq. (1) from values of A (along axis 0) at the given B_off^2; ``grazing``:
+    A at B_off^2 = 1 where the grid stops short of it (else the last value is held)."""
     b2 = np.asarray(b_off2, dtype=float)
     a = np.asarray(values, dtype=float)
     if b2.ndim != 1 or len(b2) != len(a) or len(b2) == 0:
@@ -41,6 +53,9 @@ def b_off_average(b_off2, values) -> np.ndarray:
         raise ValueError("B_off^2 must lie in [0, 1]")
     if len(np.unique(b2)) != len(b2):
         raise ValueError("repeated B_off^2 values: average the runs of one B_off^2 first")
+    if grazing is not None and b2.max() < 1:
+        b2 = np.append(b2, 1.0)
+        a = np.concatenate([a, np.full((1, *a.shape[1:]), grazing, dtype=float)])
     order = np.argsort(b2)
     b2, a = b2[order], a[order]
     grid = np.concatenate([[0.0], b2, [1.0]])
@@ -59,11 +74,55 @@ def b_off_groups(runs, value) -> tuple[np.ndarray, np.ndarray]:
     return b2, np.array([np.mean(by_b2[b], axis=0) for b in b2])
 
 
-def b_off_mean(runs, value) -> np.ndarray:
+def b_off_mean(runs, value, grazing=None) -> np.ndarray:
     """<A> of eq. (1) over ``runs`` (outcomes at one v_col): A = value(run) averaged over
     the runs (seeds) of each B_off^2 first (``b_off_groups``), then over B_off^2 by
-    ``b_off_average``."""
-    return b_off_average(*b_off_groups(runs, value))
+    ``b_off_average``; on the paper's grid less its grazing end (``jkrdt.protocol``)
+    B_off^2 = 1 takes ``grazing``, A of a collision that does not happen."""
+    b2, a = b_off_groups(runs, value)
+    return b_off_average(b2, a, grazing if protocol.is_paper_grid(b2) else None)
+
+
+def seed_scatter(runs, value, grazing=None) -> dict:
+    """<A> of eq. (1) for each seed whose runs cover every B_off^2 of ``runs``, and their
+    mean and standard error over seeds (NaN for fewer than two seeds)."""
+    grid = {round(o["B_off"] ** 2, 12) for o in runs}
+    seeds = sorted({o["seed"] for o in runs})
+    per = {}
+    for k in seeds:
+        mine = [o for o in runs if o["seed"] == k]
+        if {round(o["B_off"] ** 2, 12) for o in mine} == grid:
+            per[k] = float(b_off_mean(mine, value, grazing))
+    x = np.array(list(per.values()))
+    se = float(x.std(ddof=1) / np.sqrt(len(x))) if len(x) > 1 else float("nan")
+    return dict(per_seed=per, mean=float(x.mean()) if len(x) else float("nan"), se=se)
+
+
+def offset_table(groups) -> dict:
+    """The 3D BPCA paper's Fig. B.1 for each model: f_gro (seeds averaged) per B_off^2
+    (rows) and v_col (columns), from ``groups[(model, v_col)] = runs``."""
+    table = defaultdict(dict)
+    for (name, v), runs in sorted(groups.items()):
+        b2, f = b_off_groups(runs, lambda o: o["growth_efficiency"])
+        for b, value in zip(b2, f):
+            table[name].setdefault(f"{b:.4f}", {})[f"{v:g}"] = float(value)
+    return {name: dict(sorted(rows.items())) for name, rows in table.items()}
+
+
+def offset_table_text(table: dict) -> str:
+    """``offset_table`` as the text ``jkrdt summarise`` prints: B_off^2 as k/12 where it
+    is one, a column per v_col."""
+    lines = []
+    for name, rows in table.items():
+        speeds = sorted({v for row in rows.values() for v in row}, key=float)
+        lines.append(f"f_gro by B_off^2 and v_col (m/s), {name} (the paper's Fig. B.1):")
+        lines.append("B_off^2 " + "".join(f"{v:>8}" for v in speeds))
+        for b, row in rows.items():
+            k = float(b) * 12
+            name_b = f"{round(k)}/12" if abs(k - round(k)) < 1e-3 else b
+            lines.append(f"{name_b:<8}" + "".join(
+                f"{row[v]:+8.3f}" if v in row else f"{'':>8}" for v in speeds))
+    return "\n".join(lines)
 
 
 def threshold_velocity(v_col, mean_f_gro) -> float | None:
@@ -87,6 +146,38 @@ def cumulative_on(n_grid: np.ndarray, sizes, n_cum) -> np.ndarray:
     return np.where(at >= 0, n_cum[np.maximum(at, 0)], 0.0)
 
 
+def diagnostics(out: dict) -> dict:
+    """The paper's diagnostics (``DIAGNOSTICS``) of one run's outcome (outcome.json as
+    ``analysis.run`` writes it): None where the run's record lacks them (no log, or a log
+    of a plugin that did not count contacts made and cut)."""
+    by = out.get("dissipated_by_channel") or {}
+    at = cumulative_on(np.array(N_CUM_AT), out["fragment_sizes"], out["N_cum"]) \
+        if out.get("fragment_sizes") else [None] * len(N_CUM_AT)
+    return dict(N_con=out.get("N_con"), N_cut=out.get("N_cut"),
+                E_dis_tot=out.get("dissipated_fraction"), E_dis_c=by.get("events"),
+                E_dis_v=by.get("damping"), E_dis_sliding=by.get("sliding"),
+                E_dis_rolling=by.get("rolling"), E_dis_twisting=by.get("twisting"),
+                **{f"N_cum_{n}": None if c is None else int(c) for n, c in zip(N_CUM_AT, at)})
+
+
+def mean_diagnostic(runs, name: str) -> float | None:
+    """<A> of eq. (1) of one of the paper's diagnostics (``DIAGNOSTICS``) over ``runs``,
+    the grazing offset adding nothing; None where a run lacks it."""
+    values = [diagnostics(o)[name] for o in runs]
+    if any(v is None for v in values):
+        return None
+    grazing = (protocol.grazing_cumulative(int(name.split("_")[-1]), runs[0]["N_tar"],
+                                           runs[0]["N_pro"])
+               if name.startswith("N_cum_") else 0.0)
+    return float(b_off_mean(runs, lambda o: diagnostics(o)[name], grazing))
+
+
+def scalars(out: dict) -> dict:
+    """One run's row of runs.csv: the outcome's ``SCALARS``, its diagnostics among them."""
+    row = dict(out, **diagnostics(out))
+    return {k: row.get(k, "steps" if k == "stop_reason" else None) for k in SCALARS}
+
+
 def label(run: dict) -> str:
     tvis = run.get("tvis") or 0.0
     return f"{run.get('material')} {run.get('model')}, T_vis = {tvis * 1e12:g} ps"
@@ -108,8 +199,7 @@ def summarise(campaign, plot: bool = True, include_cap: bool = False) -> dict:
     every = load_outcomes(campaign)
     if not every:
         raise ValueError(f"{campaign}: no outcome.json below it; run 'jkrdt analyse' on its runs")
-    rows = [{k: o.get(k, "steps" if k == "stop_reason" else None) for k in SCALARS}
-            for o in every]
+    rows = [scalars(o) for o in every]
     write_csv(campaign / "runs.csv", rows)
     allowed = set(COMPLETE) | ({"cap"} if include_cap else set())
     outcomes, left_out = [], []
@@ -126,32 +216,48 @@ def summarise(campaign, plot: bool = True, include_cap: bool = False) -> dict:
     if not outcomes:
         raise ValueError(f"{campaign}: none of its {len(every)} runs is complete "
                          f"({sorted({d['stop_reason'] for d in left_out})}); see runs.csv")
-    rows = [{k: o.get(k) for k in SCALARS} for o in outcomes]
+    rows = [scalars(o) for o in outcomes]
 
     groups = defaultdict(list)
     for o in outcomes:
         groups[(label(o), o["v_col"])].append(o)
     table, curves, cumulative = [], defaultdict(lambda: ([], [])), {}
     counts = defaultdict(list)
+    g = protocol.GRAZING
+    per_seed = defaultdict(dict)
     for (name, v), runs in sorted(groups.items()):
         n_grid = np.arange(1, runs[0]["n_total"] + 1)
-        mean_f = float(b_off_mean(runs, lambda o: o["growth_efficiency"]))
+        f_gro = lambda o: o["growth_efficiency"]    # noqa: E731
+        mean_f = float(b_off_mean(runs, f_gro, g["growth_efficiency"]))
+        scatter = seed_scatter(runs, f_gro, g["growth_efficiency"])
+        for k, f in scatter["per_seed"].items():
+            per_seed[name].setdefault(k, ([], []))
+            per_seed[name][k][0].append(v)
+            per_seed[name][k][1].append(f)
         table.append(dict(model=name, v_col=v, runs=len(runs), left_out=dropped[(name, v)],
                           capped=capped[(name, v)],
                           B_off2_values=len({round(o["B_off"] ** 2, 12) for o in runs}),
-                          mean_f_gro=mean_f,
+                          paper_grid=protocol.is_paper_grid([o["B_off"] ** 2 for o in runs]),
+                          mean_f_gro=mean_f, seeds=len(scatter["per_seed"]),
+                          mean_f_gro_se=scatter["se"],
                           mean_N_lar_over_N_total=float(b_off_mean(
-                              runs, lambda o: o["n_largest"] / o["n_total"])),
+                              runs, lambda o: o["n_largest"] / o["n_total"],
+                              g["N_lar_over_N_total"])),
+                          **{f"mean_{k}": mean_diagnostic(runs, k) for k in DIAGNOSTICS},
                           E_imp_over_nk_Ebreak=runs[0]["E_imp_over_nk_Ebreak"]))
         curves[name][0].append(v)
         curves[name][1].append(mean_f)
         counts[name].append(len(runs))
         cumulative[f"{name}, {v:g} m/s"] = (n_grid, b_off_mean(
-            runs, lambda o: cumulative_on(n_grid, o["fragment_sizes"], o["N_cum"])))
+            runs, lambda o: cumulative_on(n_grid, o["fragment_sizes"], o["N_cum"]),
+            protocol.grazing_cumulative(n_grid, runs[0]["N_tar"], runs[0]["N_pro"])))
     thresholds = {name: threshold_velocity(v, f) for name, (v, f) in curves.items()}
+    seed_thresholds = {name: {k: threshold_velocity(v, f) for k, (v, f) in seeds.items()}
+                       for name, seeds in per_seed.items()}
     write_csv(campaign / "summary.csv", table)
     summary = dict(runs=len(outcomes), left_out=left_out, include_cap=include_cap, table=table,
-                   v_fra=thresholds)
+                   v_fra=thresholds, v_fra_per_seed=seed_thresholds,
+                   f_gro_by_offset=offset_table(groups))
     if plot:
         pictures = plots.growth_efficiency(campaign / "growth_efficiency", dict(curves), thresholds,
                                           dict(counts))

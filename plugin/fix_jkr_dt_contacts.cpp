@@ -583,9 +583,14 @@ void FixJKRDTContacts::unpack_restart(int nlocal, int nth)
     if (!dnum) continue;
     JKRDT::relayout(buf, file, values[nlocal] + k * dnum, state);
   }
-  for (int l = 0; l < NLEDGER; l++) ledger[nlocal][l] = *buf++;
-  // files written before the owner ID was stored end here: their IDs are the atoms' own
-  const bool has_owner = buf - record < static_cast<int>(record[0]);
+  // what follows: the ledger and the owner ID. Files written before the contacts made and
+  // cut were counted hold the losses alone (their counts start at 0); files written before
+  // the owner ID was stored end after the ledger: their IDs are the atoms' own
+  const int rest = static_cast<int>(record[0]) - static_cast<int>(buf - record);
+  const int nled = rest > NLOSS + 1 ? NLEDGER : NLOSS;
+  std::fill(ledger[nlocal], ledger[nlocal] + NLEDGER, 0.0);
+  for (int l = 0; l < nled; l++) ledger[nlocal][l] = *buf++;
+  const bool has_owner = rest > nled;
   owner[nlocal] = has_owner ? (tagint) ubuf(*buf).i : atom->tag[nlocal];
 }
 

@@ -41,10 +41,10 @@
    the current layout (0 for the frictionless model).
 
    Each atom also keeps a ledger of the energy dissipated in its contacts,
-   one column per channel; half of each contact's dissipation goes to each of
-   its two atoms. The ledger sums to the dissipated energies of
-   compute pair jkr/dt, survives migration and restarts, and is the fix's
-   per-atom array.                                                          */
+   one column per channel, and of the contacts made and cut; half of each
+   contact's dissipation and events goes to each of its two atoms. The
+   ledger sums to values 5-9, 11 and 12 of compute pair jkr/dt, survives
+   migration and restarts, and is the fix's per-atom array.                                                          */
 
 #ifndef JKR_DT_FIX_CONTACTS_H
 #define JKR_DT_FIX_CONTACTS_H
@@ -72,14 +72,18 @@ class FixJKRDTContacts : public Fix {
     std::function<void()> on_lost_contact;    // a stored contact left the list: say why, stop
   } writer;
 
-  // ledger columns: energy dissipated by channel, the kernel's loss channels
+  // ledger columns: energy dissipated by channel (the kernel's loss channels), then the
+  // contacts made and cut (halves: each event is booked half to each atom)
   enum Ledger {
     FORM_BREAK = JKRDT::LOSS_FORM_BREAK,
     DAMPING = JKRDT::LOSS_DAMPING,
     SLIDING = JKRDT::LOSS_SLIDING,
     ROLLING = JKRDT::LOSS_ROLLING,
     TWISTING = JKRDT::LOSS_TWISTING,
-    NLEDGER = JKRDT::NLOSS
+    NLOSS = JKRDT::NLOSS,
+    MADE = JKRDT::LEDGER_MADE,
+    CUT = JKRDT::LEDGER_CUT,
+    NLEDGER = JKRDT::NLEDGER
   };
 
   FixJKRDTContacts(class LAMMPS *, int, char **);

@@ -42,6 +42,11 @@ namespace JKRDT {
 
 // where a step's dissipation goes: the columns of the energy ledger
 enum Loss { LOSS_FORM_BREAK = 0, LOSS_DAMPING, LOSS_SLIDING, LOSS_ROLLING, LOSS_TWISTING, NLOSS };
+// the ledger's columns: the losses, then the contacts made and cut in a run's steps (N_con
+// and N_cut of the 3D BPCA paper, App. C.2: formation at delta >= 0, breaking at delta <
+// -delta_c, section 2.1), half of each event to each atom, so that every rank count sums
+// them exactly
+enum LedgerColumn { LEDGER_MADE = NLOSS, LEDGER_CUT, NLEDGER };
 
 // the coefficients of one type pair, after defaults and mixing
 struct Coefficients {

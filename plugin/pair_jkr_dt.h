@@ -66,7 +66,7 @@ class PairJKRDT : public Pair {
     double zeta, xi, phi;    // |zeta|, |xi|, |phi|, eqs. (10), (20), (24); 0 if off
   };
 
-  static constexpr int NPVECTOR = 10;
+  static constexpr int NPVECTOR = 12;
   static const char *const FIX_ID;
   // the group of grains in fragments that have left the collision for good (fix
   // jkr/dt/settle depart): they keep their velocities but no longer move or interact
@@ -198,7 +198,7 @@ class PairJKRDT : public Pair {
   };
   struct FarLoad {
     int atom;
-    double f[3], torque[3], loss[JKRDT::NLOSS];
+    double f[3], torque[3], loss[JKRDT::NLEDGER];    // loss: the ledger's columns
   };
   struct Accumulator {
     int thread;

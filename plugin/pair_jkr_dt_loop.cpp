@@ -44,7 +44,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <type_traits>
 #include <utility>
 #if defined(_OPENMP)
 #include <omp.h>
@@ -185,7 +184,7 @@ void PairJKRDT::compute(int eflag, int vflag)
           f[l.atom][k] += l.f[k];
           tq[l.atom][k] += l.torque[k];
         }
-        for (int k = 0; k < JKRDT::NLOSS; k++) ledger[l.atom][k] += l.loss[k];
+        for (int k = 0; k < JKRDT::NLEDGER; k++) ledger[l.atom][k] += l.loss[k];
       }
   }
 
@@ -345,7 +344,7 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
   enum class Eval { SKIP, DONE, TROUBLE, LEAN };    // LEAN: lean_put() took it
   struct Done {
     int p, q, s, owned;
-    bool parked, setup;
+    bool parked, setup, formed;
     V3 d12;
     JKRDT::ContactMotion m;     // kept here: a lane reads it back (TangentialLanes::put)
     JKRDT::ContactResult out;
@@ -379,7 +378,8 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
   // finish (a guard, a contact that breaks: returns its k, nothing of it applied, for
   // evaluate() and deliver(), which give the same bits) and at a force that is not finite
   // (returns -(k + 1)); else it returns k1
-  const bool lean_steps = !TANGENTIAL && !run_setup && !tally_atoms && !eflag && !vflag_either;
+  const bool lean_step = !run_setup && !tally_atoms && !eflag && !vflag_either;
+  const bool lean_steps = !TANGENTIAL && lean_step;
   auto lean_run_body = [&](int k0, int k1) __attribute__((always_inline)) -> int {
     // the values the run reads, in locals: a store to a force may not alias them
     const double *const vv = v;
@@ -429,7 +429,7 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
   // (contact_normal_part, then TangentialLanes::put) and lean_deliver() adds their loads
   // after the lanes' step. lean_put() stops, nothing of the pair applied, at a pair that
   // needs a guard, breaks or has no pointers yet, and returns its k
-  const bool lean_lanes = lanes && !run_setup && !tally_atoms && !eflag && !vflag_either;
+  const bool lean_lanes = lanes && lean_step;
   auto lean_put_body = [&](int k0, int k1, int &nlane) __attribute__((always_inline)) -> int {
     const double *const vv = v, *const ww = omega;
     const double step_dt = dt, skin_half = half_skin;
@@ -587,6 +587,7 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
       }
       if (!setup) step_max = std::max(step_max, step * K.inv_delta_c);
       const bool formed = !bonded;    // delta >= 0 here: contact formation (section 2.1)
+      o.formed = formed;
       if (formed && setup && delta >= std::min(radius[p], radius[q])) {
         trouble(Trouble::OVERLAP, p, q, delta, 0.0, K);
         return Eval::TROUBLE;
@@ -651,7 +652,7 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
             fa = f + 3 * a;
             ta = tq + 3 * a;
           } else {
-            acc.far.push_back(FarLoad{a, {0, 0, 0}, {0, 0, 0}, {0, 0, 0, 0, 0}});
+            acc.far.push_back(FarLoad{a, {0, 0, 0}, {0, 0, 0}, {}});
             fa = acc.far.back().f;
             ta = acc.far.back().torque;
             far_loss = acc.far.back().loss;
@@ -659,6 +660,10 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
           if (lossy && !o.setup) {    // the atom's ledger row only when it books
             double *la = far_loss ? far_loss : ledger[a];
             for (int l = 0; l < nloss; l++) la[l] += 0.5 * out.loss[l];
+            // N_con, N_cut (3D BPCA paper, App. C.2): every formation and breaking books
+            // a loss, and only here (the lean paths leave both to this step)
+            if (o.formed) la[JKRDT::LEDGER_MADE] += 0.5;
+            if (broken) la[JKRDT::LEDGER_CUT] += 0.5;
           }
           if (broken) continue;
           const V3 fa_add = side ? -fp : fp;
@@ -799,8 +804,9 @@ PairJKRDT::pair_loop_avx2(int ii_from, int ii_to, int eflag, bool tally_atoms, C
 #endif
 
 /* ----------------------------------------------------------------------
-   this rank's share of the 10 values of compute pair jkr/dt; compute pair
-   sums them over ranks
+   this rank's share of the 12 values of compute pair jkr/dt; compute pair
+   sums them over ranks: the potentials, the losses, the bonded contacts,
+   the contacts made and cut
 ------------------------------------------------------------------------- */
 
 void PairJKRDT::fill_pvector(double upot, const double *utan, double contacts)
@@ -809,8 +815,11 @@ void PairJKRDT::fill_pvector(double upot, const double *utan, double contacts)
   pvector[0] = upot;    // U_n
   for (int ch = 0; ch < JKRDT::NCHANNEL; ch++) pvector[1 + ch] = utan[ch];    // U_s, U_r, U_t
   const auto &C = *fix_contacts;
-  for (int i = 0; i < atom->nlocal; i++)
-    for (int l = 0; l < Contacts::NLEDGER; l++) pvector[4 + l] += C.ledger[i][l];
+  for (int i = 0; i < atom->nlocal; i++) {
+    for (int l = 0; l < Contacts::NLOSS; l++) pvector[4 + l] += C.ledger[i][l];
+    pvector[10] += C.ledger[i][Contacts::MADE];
+    pvector[11] += C.ledger[i][Contacts::CUT];
+  }
   pvector[9] = contacts;
   for (int l = 0; l < NPVECTOR; l++)
     if (!std::isfinite(pvector[l]))

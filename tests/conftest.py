@@ -74,10 +74,10 @@ def two_grain_scene(lmp, separation, v_rel=0.0, material=ICE, coeff_extra="frict
 
 
 def ledger(lmp):
-    """Energies at the current step: ke, erot, pe, the 10 values of compute pair
-    jkr/dt as p1..p10, 'dissipated' (slots 5-9) and 'total', the conserved sum."""
+    """Energies at the current step: ke, erot, pe, the 12 values of compute pair
+    jkr/dt as p1..p12, 'dissipated' (slots 5-9) and 'total', the conserved sum."""
     p = lmp.numpy.extract_compute("p", 0, 1)
-    e = {f"p{k + 1}": float(p[k]) for k in range(10)}
+    e = {f"p{k + 1}": float(p[k]) for k in range(12)}
     e["ke"] = lmp.get_thermo("ke")
     e["pe"] = lmp.get_thermo("pe")
     e["erot"] = float(lmp.extract_compute("erot", 0, 0))

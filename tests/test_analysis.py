@@ -90,6 +90,26 @@ def test_b_off_average_eq1():
     assert np.allclose(b_off_average(B2[shuffled], both), [1.0, 0.5], rtol=1e-14)
 
 
+def test_eq1_on_the_papers_offsets_takes_the_grazing_end_as_no_collision():
+    """The paper's protocol runs B_off^2 = k/12, k = 0 ... 11; at 12/12 the aggregates
+    graze (f_gro 0). The trapezoid over the thirteen points then weighs the head-on run
+    1/24, each inner offset 1/12 and 11/12 1/24: A = 1 wherever run averages to 23/24."""
+    from jkrdt import protocol
+
+    b2 = np.array(protocol.B_OFF2)
+    assert len(b2) == 12 and protocol.is_paper_grid(b2) and not protocol.is_paper_grid(B2)
+    assert b_off_average(b2, np.ones(12), grazing=0.0) == pytest.approx(23 / 24, rel=1e-14)
+    # A = B^2 with its own value (1) at the grazing end: exact, 1/2
+    assert b_off_average(b2, b2, grazing=1.0) == pytest.approx(0.5, rel=1e-14)
+    # weights: head-on 1/24, then 1/12 each
+    head_on = np.eye(12)[0]
+    assert b_off_average(b2, head_on, grazing=0.0) == pytest.approx(1 / 24, rel=1e-14)
+    # a grid that reaches 1 ignores it; without it the last value is held
+    assert b_off_average(B2, np.ones(13), grazing=0.0) == pytest.approx(1.0, rel=1e-14)
+    assert protocol.V_COL == [10.0, 12.6, 15.8, 20.0, 25.1, 31.6, 39.8, 50.1, 63.1, 79.4,
+                              100.0]
+
+
 def test_b_off_average_refuses_bad_grids():
     with pytest.raises(ValueError, match="B_off\\^2 must lie"):
         b_off_average([0.0, 1.5], [1, 1])

@@ -214,7 +214,23 @@ def test_spec_errors_name_the_fix(tmp_path):
     spec.write_text(json.dumps(dict(SPEC, settle=dict(windows=3))))
     with pytest.raises(ValueError, match="settle takes"):
         run_campaign(spec, tmp_path / "runs", progress=False)
+    spec.write_text(json.dumps(dict(SPEC, b_off2="twelfths")))
+    with pytest.raises(ValueError, match="a list of numbers or \"paper\""):
+        run_campaign(spec, tmp_path / "runs", progress=False)
     assert not (tmp_path / "runs").exists()
+
+
+def test_the_papers_protocol_by_name(tmp_path):
+    """"v_col": "paper" and "b_off2": "paper" are the 3D BPCA paper's grids: eleven speeds
+    10^(0.1 i) m/s, i = 10 ... 20, and B_off^2 = k/12, k = 0 ... 11."""
+    from jkrdt import protocol
+    from jkrdt.campaign import plan, read_spec
+
+    spec = tmp_path / "spec.json"
+    spec.write_text(json.dumps(dict(SPEC, v_col="paper", b_off2="paper")))
+    read = read_spec(spec)
+    assert read["v_col"] == protocol.V_COL and read["b_off2"] == protocol.B_OFF2
+    assert len(plan(read, tmp_path / "runs")) == 11 * 12 * len(read["seeds"])
 
 
 def jkrdt_campaign(spec, where, *options):

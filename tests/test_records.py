@@ -77,7 +77,8 @@ def test_a_run_cut_off_continues_as_the_uninterrupted_one_and_a_finished_one_is_
                        capture_output=True, timeout=300)
         outcomes.append(json.loads((d / "outcome.json").read_text()))
     for key in ("stop_reason", "stop_step", "n_largest", "n_fragments", "contacts_per_particle",
-                "gyration_radius_largest", "dissipated_fraction", "energy_error"):
+                "gyration_radius_largest", "dissipated_fraction", "energy_error", "N_con",
+                "N_cut"):
         assert outcomes[1][key] == outcomes[0][key], key
     frames = [(d / "frames.csv").read_text().splitlines()[1:] for d in (straight, cut)]
     assert [r.split(",")[0] for r in frames[1]] == [r.split(",")[0] for r in frames[0]]

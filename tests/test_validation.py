@@ -293,6 +293,50 @@ def test_the_offset_grid_study_averages_the_papers_twelfths_and_the_four(tmp_pat
         np.trapezoid([f[0], f[3], f[6], f[9], f[9]], [0, 0.25, 0.5, 0.75, 1.0]), abs=1e-12)
 
 
+def test_the_paper_protocol_study_averages_twelve_offsets_and_keeps_every_record(tmp_path):
+    # validation/paper_protocol.py --quick, questions a and b: 2 x 24 frictionless ice
+    # BPCAs, seeds 1 and 2, head-on at 100 m/s (the paper's f_gro about -1: far above this
+    # size's v_fra, about 15 m/s, both shatter) and at 39.8 m/s on the paper's twelve
+    # offsets. <f_gro> is the trapezoid over k/12 with the grazing 12/12 at 0, each seed
+    # on its own and both; the results come from the kept records alone
+    results = run_quick("paper_protocol", tmp_path, "--questions", "a", "b")
+    runs = read_csv(results / "runs.csv")
+    assert len(runs) == 2 + 24 and all(r["stop_reason"] == "settled" for r in runs)
+    assert max(r["energy_error"] for r in runs) < 1e-3
+    a = [r for r in runs if r["question"] == "a"]
+    assert all(r["growth_efficiency"] < -0.5 for r in a)
+    summary = json.loads((results / "summary.json").read_text())["results"]
+    b = summary["by_question"]["b"]["24"]
+    assert b["paper_grid"] and len(b["B_off2"]) == 12
+    k = np.arange(13) / 12
+    per_seed = {}
+    for seed in (1, 2):
+        f = [r["growth_efficiency"] for r in sorted(
+            (r for r in runs if r["question"] == "b" and r["seed"] == seed),
+            key=lambda r: r["B_off"])]
+        per_seed[seed] = np.trapezoid(f + [0.0], k)
+    m = b["mean_f_gro"]
+    assert m["per_seed"]["1"] == pytest.approx(per_seed[1], abs=1e-12)
+    assert m["per_seed"]["2"] == pytest.approx(per_seed[2], abs=1e-12)
+    assert m["mean"] == pytest.approx(np.mean(list(per_seed.values())), abs=1e-12)
+    assert m["se"] == pytest.approx(abs(per_seed[1] - per_seed[2]) / 2, abs=1e-12)
+    # N_con - N_cut is the change in bonded contacts, exactly, in every run
+    for o in map(json.loads, (p.read_text() for p in (results / "records").rglob(
+            "outcome.json"))):
+        assert o["N_con"] - o["N_cut"] == o["contacts_end"] - o["contacts_start"]
+    rows = {s["paper"].split(" (")[0]: s for s in summary["statements"]}
+    assert rows["frictionless, undamped: E_dis,c = E_dis,tot"]["holds"]
+    # the runs gone, the records alone give the same results
+    before = (results / "summary.json").read_text()
+    shutil.rmtree(tmp_path / "runs")
+    run_quick("paper_protocol", tmp_path, "--summary-only")
+    assert (results / "summary.json").read_text() == before
+    record = next((results / "records").rglob("outcome.json")).parent
+    assert sorted(p.name for p in record.iterdir()) == sorted(
+        ["collision.json", "checks.csv", "frames.csv", "outcome.json", "outcome.png",
+         "timeline.png"])
+
+
 def test_a_grid_that_misses_v_fra_is_extended_along_the_papers_speeds():
     # at 2 x 5000 the damped frictionless <f_gro> was <= 0 already at the slowest speed of
     # the grid that 2 x 1000 placed (50.1 m/s): the study then adds the paper's next speed,

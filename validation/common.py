@@ -31,13 +31,30 @@ def campaign_study_parser(doc: str) -> argparse.ArgumentParser:
     return p
 
 
+#: where each study's runs go -> where their small records go (``study_paths``)
+RECORDS_OF: dict[Path, Path] = {}
+
+
 def study_paths(args, study: str) -> tuple[Path, Path]:
-    """(runs, results) of ``study`` for the parsed options; the results folder made."""
+    """(runs, results) of ``study`` for the parsed options; the results folder made. The
+    small record of every run a campaign below ``runs`` finishes goes to the same place
+    below ``results/records`` (``run_campaigns``)."""
     tag = study + ("_quick" if args.quick else "")
     runs = args.runs or HERE / "runs" / tag
     results = args.results or HERE / tag
     results.mkdir(parents=True, exist_ok=True)
+    RECORDS_OF[Path(runs).resolve()] = results / "records"
     return runs, results
+
+
+def records_of(campaign: Path) -> Path | None:
+    """Where the records of ``campaign``'s runs go: its place below its study's runs,
+    below the study's ``results/records``; None outside every study's runs."""
+    campaign = Path(campaign).resolve()
+    for runs, records in RECORDS_OF.items():
+        if campaign.is_relative_to(runs):
+            return records / campaign.relative_to(runs)
+    return None
 
 
 def loop_times(run: Path) -> list[tuple[float, int]]:
@@ -82,7 +99,8 @@ def run_campaigns(specs: dict[str, dict], runs: Path, ranks: int,
                   ranks_per_run: int = 1) -> dict[str, Path]:
     """Run one ``jkrdt campaign`` per spec (``runs/<name>``), each over ``ranks`` MPI ranks
     in groups of ``ranks_per_run`` (each group runs whole collisions); a second call resumes
-    them. Returns the campaign directories."""
+    them. As each campaign ends its finished runs' small records are kept (``records_of``,
+    ``keep_records``). Returns the campaign directories."""
     runs.mkdir(parents=True, exist_ok=True)
     where = campaign_paths(specs, runs)
     for name, spec in specs.items():
@@ -99,7 +117,35 @@ def run_campaigns(specs: dict[str, dict], runs: Path, ranks: int,
         print(f"{name}: campaign done in {time.time() - t0:.0f} s"
               + (" (some runs failed: see their outcome.json)" if done.returncode else ""),
               flush=True)
+        records = records_of(where[name])
+        if records is not None:
+            keep_records(where[name], records)
     return where
+
+
+def keep_records(campaign: Path, records: Path) -> list[Path]:
+    """Copy the small record (``jkrdt.rundir.RECORD``) of every finished run below
+    ``campaign`` to the same place below ``records``, so that the study re-analyses and
+    re-plots from the repository alone once its run directories are gone. A record is
+    copied whole or not at all (its outcome.json last) and never replaced; returns the
+    records it copied."""
+    import shutil
+
+    from jkrdt import rundir
+
+    kept = []
+    for outcome in sorted(Path(campaign).rglob(rundir.OUTCOME)):
+        run = outcome.parent
+        to = records / run.relative_to(campaign)
+        if (to / rundir.OUTCOME).exists():
+            continue
+        to.mkdir(parents=True, exist_ok=True)
+        for name in rundir.RECORD:
+            if (run / name).exists() and name != rundir.OUTCOME:
+                shutil.copy2(run / name, to / name)
+        shutil.copy2(outcome, to / rundir.OUTCOME)
+        kept.append(to)
+    return kept
 
 
 def save(fig, results: Path, stem: str) -> list[Path]:

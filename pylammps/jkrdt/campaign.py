@@ -9,7 +9,9 @@ A spec (JSON) names the grid and the scene:
      "dt": 0.014, "settle": {"check_tc": 50, "window": 5, "tolerance": 0.01,
                              "counts": 1e-4, "cap_tc": 40000}}
 
-n_tar, n_pro, v_col and b_off2 are required; the other keys default to the values above
+n_tar, n_pro, v_col and b_off2 are required; ``"v_col": "paper"`` and ``"b_off2": "paper"``
+are the 3D BPCA paper's grids (``jkrdt.protocol``: 10^(0.1 i) m/s for i = 10 ... 20, and
+B_off^2 = k/12 for k = 0 ... 11, the grazing 12/12 taken as no collision); the other keys default to the values above
 (material_overrides {}, settle {} = the settle rule's defaults), and any Material field
 can be overridden in material_overrides. "dt" is in units of t_c, or "auto": each speed's
 dt then comes from "tolerance" (max |dE| / E_imp, default 1e-4) as ``jkrdt setup --dt auto
@@ -56,7 +58,7 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
-from . import rundir
+from . import protocol, rundir
 from .aggregates import BUILDERS
 from .materials import material
 from .scene import Scene
@@ -82,9 +84,9 @@ CHECKS = {
     "n_tar": (lambda x: _whole(x) and x >= 1, "a whole number of grains >= 1"),
     "n_pro": (lambda x: _whole(x) and x >= 1, "a whole number of grains >= 1"),
     "v_col": (lambda x: isinstance(x, list) and x and all(_number(v) and v > 0 for v in x),
-              "a non-empty list of speeds > 0 in m/s, e.g. [10, 20]"),
+              "a non-empty list of speeds > 0 in m/s, e.g. [10, 20], or \"paper\""),
     "b_off2": (lambda x: isinstance(x, list) and x and all(_number(b) for b in x),
-               "a non-empty list of B_off^2 values in [0, 1], e.g. [0, 0.5, 1]"),
+               "a non-empty list of B_off^2 values in [0, 1], e.g. [0, 0.5, 1], or \"paper\""),
     "seeds": (lambda x: isinstance(x, list) and x and all(_whole(k) for k in x),
               "a non-empty list of whole numbers, e.g. [1, 2]"),
     "kind": (lambda x: x in BUILDERS, f"one of {sorted(BUILDERS)}"),
@@ -132,6 +134,12 @@ def read_spec(path) -> dict:
     missing = [k for k in REQUIRED if k not in spec]
     if missing:
         raise ValueError(f"{path}: the campaign spec lacks {missing}")
+    for key, grid in (("v_col", protocol.V_COL), ("b_off2", protocol.B_OFF2)):
+        if isinstance(spec[key], str):
+            if spec[key] != protocol.PAPER:
+                raise ValueError(f"{path}: \"{key}\" is a list of numbers or \"paper\" (the "
+                                 f"3D BPCA paper's grid), not {spec[key]!r}")
+            spec[key] = list(grid)
     check_types(path, spec)
     if spec["dt"] == "auto" and spec["tolerance"] is None:
         spec["tolerance"] = AUTO_TOLERANCE

@@ -351,11 +351,17 @@ def summarise(args) -> int:
                                      include_cap=args.include_cap)
     except ValueError as err:
         raise SystemExit(f"jkrdt: {err}") from None
+    from jkrdt.analysis.summary import offset_table_text
+
     for row in summary["table"]:
+        se = row["mean_f_gro_se"]
         print(f"{row['model']:<40} v_col {row['v_col']:7.3g} m/s  <f_gro> {row['mean_f_gro']:+.3f}"
-              f"  ({row['runs']} runs" + (f", {row['left_out']} left out" if row["left_out"]
-                                         else "")
-              + (f", {row['capped']} hit the cap" if row["capped"] else "") + ")")
+              + (f" +- {se:.3f} ({row['seeds']} seeds)" if se == se else "")
+              + f"  ({row['runs']} runs" + (f", {row['left_out']} left out" if row["left_out"]
+                                           else "")
+              + (f", {row['capped']} hit the cap" if row["capped"] else "")
+              + (", the paper's offsets" if row["paper_grid"] else "") + ")")
+    print(offset_table_text(summary["f_gro_by_offset"]))
     for gone in summary["left_out"]:
         print(f"left out ({gone['stop_reason']}): {gone['run']}"
               + (f": {gone['problem']}" if gone.get("problem") else ""))

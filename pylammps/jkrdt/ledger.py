@@ -1,12 +1,15 @@
 """The energy ledger: the layout of ``compute pair jkr/dt``'s vector, the thermo line that
 carries it, and the energy budget a run conserves.
 
-The plugin's compute gives 10 values (its manual page, "Output"):
+The plugin's compute gives 12 values (its manual page, "Output"):
 
     1-4   U_n, U_s, U_r, U_t: the normal, sliding, rolling and twisting potentials
     5-9   energy dissipated by contact formation and breaking ('events'), damping,
           sliding, rolling and twisting: the channels of the ledger
     10    the number of bonded contacts
+    11-12 the contacts made and cut since the run's first step (N_con and N_cut of the
+          3D BPCA paper, App. C.2); contacts present at the first step count as neither,
+          so value 10 = its first value + N_con - N_cut, exactly
 
 ke + erotate/sphere + pe + values 5-9 is conserved. The deck's computes kedep and erotdep
 are the part of ke and erotate that fragments which have departed (``jkrdt.stopping``)
@@ -23,16 +26,21 @@ import numpy as np
 
 #: the dissipation channels, in the order of values 5-9 of compute pair jkr/dt
 CHANNELS = ["events", "damping", "sliding", "rolling", "twisting"]
-#: 0-based index of the first channel and of the contact count in the compute's vector
-FIRST_CHANNEL, CONTACT_COUNT = 4, 9
+#: 0-based index of the first channel, of the contact count and of N_con, N_cut in the
+#: compute's vector
+FIRST_CHANNEL, CONTACT_COUNT, EVENT_COUNTS = 4, 9, (10, 11)
 #: the compute's values as thermo names (the deck's compute is called p)
 LEDGER = [f"c_p[{FIRST_CHANNEL + 1 + k}]" for k in range(len(CHANNELS))]
 CONTACTS = f"c_p[{CONTACT_COUNT + 1}]"
+#: N_con, N_cut as thermo names; a log written before they were counted lacks them
+MADE, CUT = (f"c_p[{k + 1}]" for k in EVENT_COUNTS)
 #: the deck's thermo keywords and the names LAMMPS gives their columns in a log
 #: the kinetic and rotational energy of the departed fragments (included in ke, c_erot)
 DEPARTED = ["c_kedep", "c_erotdep"]
-THERMO_KEYWORDS = ["step", "time", "ke", "c_erot", "pe", *LEDGER, CONTACTS, *DEPARTED]
-THERMO = ["Step", "Time", "KinEng", "c_erot", "PotEng", *LEDGER, CONTACTS, *DEPARTED]
+THERMO_KEYWORDS = ["step", "time", "ke", "c_erot", "pe", *LEDGER, CONTACTS, *DEPARTED,
+                   MADE, CUT]
+THERMO = ["Step", "Time", "KinEng", "c_erot", "PotEng", *LEDGER, CONTACTS, *DEPARTED,
+          MADE, CUT]
 THERMO_STYLE = "thermo_style    custom " + " ".join(THERMO_KEYWORDS)
 #: the conserved total as a LAMMPS equal-style formula over the deck's computes p, erot
 CONSERVED = "ke+c_erot+pe+" + "+".join(LEDGER)
@@ -46,7 +54,8 @@ def sample(lmp) -> list[float]:
             float(lmp.extract_compute("erot", 0, 0)), lmp.get_thermo("pe"),
             *(float(p[FIRST_CHANNEL + k]) for k in range(len(CHANNELS))),
             float(p[CONTACT_COUNT]),
-            *(float(lmp.extract_compute(name[2:], 0, 0)) for name in DEPARTED)]
+            *(float(lmp.extract_compute(name[2:], 0, 0)) for name in DEPARTED),
+            *(float(p[k]) for k in EVENT_COUNTS)]
 
 
 def energy_budget(thermo: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
@@ -66,3 +75,15 @@ def energy_error(budget: dict[str, np.ndarray], e_imp: float) -> float:
     """max |dE| / E_imp over a run, dE the change of the conserved total."""
     total = budget["total"]
     return float(np.abs(total - total[0]).max() / e_imp)
+
+
+def contact_events(thermo: dict[str, np.ndarray]) -> dict[str, float] | None:
+    """N_con and N_cut at the last row of thermo columns named as in ``THERMO`` (whole
+    numbers: the plugin books half an event to each atom), with the bonded contacts at the
+    first and last rows, whose difference they equal; None for a log written before the
+    plugin counted them."""
+    if MADE not in thermo or CUT not in thermo:
+        return None
+    return dict(N_con=float(thermo[MADE][-1]), N_cut=float(thermo[CUT][-1]),
+                contacts_start=float(thermo[CONTACTS][0]),
+                contacts_end=float(thermo[CONTACTS][-1]))

@@ -57,6 +57,10 @@ ROLLING_RESTARTS = ("restart.a", "restart.b")
 FRAMES, OUTCOME = "frames.csv", "outcome.json"
 ANALYSIS_OUTPUTS = (FRAMES, OUTCOME, "outcome.png", "outcome.pdf", "energy.png",
                     "energy.pdf", "timeline.png", "timeline.pdf")
+#: a finished run's small record, what a study commits of each run (under 1 MB at 2 x 5000):
+#: its scene's metadata, the settle rule's table, the timeline with the energy ledger, the
+#: outcome and its two pictures; the re-analysis of a study needs nothing else
+RECORD = (META, CHECKS, FRAMES, OUTCOME, "outcome.png", "timeline.png")
 #: a campaign's lock on a run (``claim``)
 CLAIM = ".claim"
 #: what a scene directory holds once set up, run and analysed (all that a fresh scene clears)

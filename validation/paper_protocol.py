@@ -1,0 +1,268 @@
+"""The 3D BPCA paper's own protocol where this tool and the paper disagree (issue 46).
+
+At the paper's size (2 x 50000) two of three models disagree with it over four offsets
+(``vfra_size --paper-size``). This study asks each disagreement as the paper would, on
+its grid of offsets (``jkrdt.protocol``: B_off^2 = k/12, eq. 1 with the grazing 12/12 as
+no collision), with its diagnostics (N_con, N_cut, E_dis by channel, N_cum: every run's
+``outcome.json["diagnostics"]``):
+
+  a   frictionless, undamped, head-on, 100 m/s: the paper's sharpest case, f_gro about -1
+      with E_dis,tot well below E_imp (App. C.1)
+  c   damped frictional (T_vis 6 ps), 63.1 m/s, B_off^2 3/12, where one seed at 2 x 50000
+      kept the projectile (f_gro +0.53) though the paper's v_fra is 50 m/s
+  b   frictionless, undamped, 39.8 m/s, on the paper's twelve offsets: <f_gro> should be
+      clearly negative (v_fra 30 m/s); four offsets gave +0.06 at 2 x 50000
+  d   frictionless, undamped, 31.6 m/s, the paper's twelve offsets: the next speed down
+
+Each question is placed first at 2 x 5000 with seeds 1 and 2 (``--stage place``, about
+ten times cheaper, two collisions side by side on the two ranks), then asked at the
+paper's 2 x 50000 where the placement says it decides something (``--stage paper``: seed
+1, each collision on all ranks; seed 2 for c). One campaign per question, size and offset
+(``RUNS/n<N>_<question>_b2_<B_off^2>``), in the order of QUESTIONS; a second call resumes
+them. Every run ends by the settle rule, its dt chosen by ``--dt auto`` for max |dE| /
+E_imp <= 1e-3 (vfra_size.TOLERANCE).
+
+The small record of every finished run (``jkrdt.rundir.RECORD``: outcome.json,
+checks.csv, collision.json, frames.csv, the outcome and timeline pictures) is copied to
+RESULTS/records/<campaign>/v<v_col>/b2_<B_off^2>/seed<k>/ as its campaign ends, and the
+results are made from those records alone:
+runs.csv (every run, its diagnostics among the columns), summary.json (per question: f_gro
+per offset and seed, <f_gro> by eq. 1 with its seed scatter where the twelve offsets ran,
+the diagnostics' eq. 1 means; the paper's statements of App. C against the runs, one row
+each) and fig_protocol (f_gro, N_con / N_tot and N_cut / N_tot against B_off^2).
+
+    ./run validate paper_protocol                   # --stage place: 2 x 5000, hours
+    ./run validate paper_protocol --questions a c
+    ./run validate paper_protocol --stage paper --questions a
+    ./run validate paper_protocol --summary-only    # the results of the records committed
+    ./run validate paper_protocol --quick           # 2 x 24 grains (tests)
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+
+from bpca3d_models import MODELS, model_spec
+from common import campaign_study_parser, run_campaigns, save, study_paths, write_summary
+from jkrdt import protocol, rundir
+from jkrdt.analysis.summary import (DIAGNOSTICS, b_off_groups, diagnostics, mean_diagnostic,
+                                    seed_scatter, scalars)
+from jkrdt.analysis.tables import write_csv
+from jkrdt.stopping import COMPLETE
+from vfra_size import TOLERANCE
+
+#: the paper's twelve offsets in the order they are run where they decide a sign: the two
+#: nearest head-on first (where f_gro falls from the head-on run's to below 0), then the four
+#: of the other studies, then the rest
+TWELFTHS_FIRST = [protocol.B_OFF2[k] for k in (1, 2, 0, 3, 6, 9, 4, 5, 7, 8, 10, 11)]
+#: the questions, in the order they run: the model, its speed, the offsets, what the paper says
+QUESTIONS = {
+    "a": dict(model="frictionless", v_col=100.0, b_off2=[0.0],
+              paper="f_gro about -1, E_dis,tot well below E_imp (App. C.1, Fig. B.1c)"),
+    "c": dict(model="frictional, T_vis 6 ps", v_col=63.1, b_off2=[0.25],
+              paper="<f_gro> below 0 above v_fra = 50 m/s (Fig. 2)"),
+    "b": dict(model="frictionless", v_col=39.8, b_off2=TWELFTHS_FIRST,
+              paper="<f_gro> below 0 above v_fra = 30 m/s (Fig. 2)"),
+    "d": dict(model="frictionless", v_col=31.6, b_off2=TWELFTHS_FIRST,
+              paper="<f_gro> about 0 at v_fra = 30 m/s (Fig. 2)"),
+}
+#: the sizes a question is asked at: its seeds, and the ranks one collision shares
+STAGES = {"place": dict(n=5000, seeds=[1, 2], ranks_per_run=1),
+          "paper": dict(n=50000, seeds=[1], ranks_per_run=2, more_seeds={"c": [1, 2]})}
+#: the tests' variant: every offset of a question in one campaign
+QUICK = dict(n=24, seeds=[1, 2], ranks_per_run=1, one_campaign=True)
+
+
+def campaign_specs(question: str, stage: dict) -> dict[str, dict]:
+    """The campaigns of one question at one stage: one per offset (or one in all), each
+    with all its seeds."""
+    q = QUESTIONS[question]
+    seeds = stage.get("more_seeds", {}).get(question, stage["seeds"])
+    groups = [q["b_off2"]] if stage.get("one_campaign") else [[b2] for b2 in q["b_off2"]]
+    return {f"n{stage['n']}/{question}/b2_{b2[0]:.4f}" + ("_all" if len(b2) > 1 else ""):
+            model_spec(q["model"], stage["n"], v_col=[q["v_col"]], b_off2=b2, seeds=seeds,
+                       dt="auto", tolerance=TOLERANCE)
+            for b2 in groups}
+
+
+def run_question(question: str, stage: dict, runs: Path, ranks: int) -> None:
+    """Every campaign of ``question`` at ``stage``, each one's records kept as it ends."""
+    for name, spec in campaign_specs(question, stage).items():
+        run_campaigns({name: spec}, runs, ranks, stage["ranks_per_run"])
+
+
+def question_of(record: Path, records: Path) -> tuple[int, str]:
+    """(N per aggregate, question) of a record below its campaign's records,
+    RESULTS/records/n<N>_<question>_b2_<B_off^2>/."""
+    size, question = record.relative_to(records).parts[0].split("_")[:2]
+    return int(size[1:]), question
+
+
+def load(records: Path) -> list[dict]:
+    """Every kept record's outcome, with its size, question and loop time."""
+    out = []
+    for path in sorted(records.rglob(rundir.OUTCOME)):
+        o = json.loads(path.read_text())
+        o["n"], o["question"] = question_of(path.parent, records)
+        out.append(o)
+    return out
+
+
+def question_summary(runs: list[dict]) -> dict:
+    """One question at one size: f_gro per offset (by seed and seeds averaged), N_con and
+    N_cut per offset over N_tot, and where the twelve offsets ran, eq. (1)'s <f_gro> with
+    its seed scatter and the diagnostics' eq. (1) means."""
+    f_gro = lambda o: o["growth_efficiency"]    # noqa: E731
+    b2, f = b_off_groups(runs, f_gro)
+    n_tot = runs[0]["n_total"]
+    per_seed = defaultdict(dict)
+    for o in runs:
+        per_seed[f"{o['B_off'] ** 2:.4f}"][o["seed"]] = o["growth_efficiency"]
+    _, con = b_off_groups(runs, lambda o: (o.get("N_con") or np.nan) / n_tot)
+    _, cut = b_off_groups(runs, lambda o: (o.get("N_cut") or np.nan) / n_tot)
+    out = dict(runs=len(runs), B_off2=[float(b) for b in b2], f_gro=[float(x) for x in f],
+               f_gro_per_seed=dict(per_seed), N_con_over_N_tot=[float(x) for x in con],
+               N_cut_over_N_tot=[float(x) for x in cut],
+               paper_grid=protocol.is_paper_grid(b2))
+    if out["paper_grid"]:
+        out["mean_f_gro"] = seed_scatter(runs, f_gro, protocol.GRAZING["growth_efficiency"])
+        out["means"] = {k: mean_diagnostic(runs, k) for k in DIAGNOSTICS}
+    return out
+
+
+def statements(rows: list[dict]) -> list[dict]:
+    """The paper's statements of App. C and Sect. 3 that give a number or a sign, each
+    against the runs that bear on it (the largest size that has them)."""
+    def pick(model=None, v=None, b2=None):
+        sel = [r for r in rows if (model is None or r["model_name"] == model)
+               and (v is None or abs(r["v_col"] - v) < 0.05)
+               and (b2 is None or abs(r["B_off"] ** 2 - b2) < 1e-6)]
+        top = max((r["N_tar"] for r in sel), default=None)
+        return [r for r in sel if r["N_tar"] == top]
+
+    def row(paper, runs, measured, holds):
+        return dict(paper=paper, runs=len(runs),
+                    size=f"2 x {runs[0]['N_tar']}" if runs else None,
+                    measured=measured if runs else "not run", holds=holds if runs else None)
+
+    out = []
+    fl = [r for r in pick("frictionless") if r["E_dis_tot"]]    # not a grazing miss
+    out.append(row("frictionless, undamped: N_con > N_tot for 10 <= v_col <= 100 m/s "
+                   "(App. C.2, Fig. C.3c)", fl,
+                   f"N_con / N_tot {min(r['N_con'] / r['n_total'] for r in fl):.2f} to "
+                   f"{max(r['N_con'] / r['n_total'] for r in fl):.2f}" if fl else None,
+                   all(r["N_con"] > r["n_total"] for r in fl)))
+    out.append(row("frictionless, undamped: N_cut > N_tot for 10 <= v_col <= 100 m/s "
+                   "(App. C.2, Fig. C.4c)", fl,
+                   f"N_cut / N_tot {min(r['N_cut'] / r['n_total'] for r in fl):.2f} to "
+                   f"{max(r['N_cut'] / r['n_total'] for r in fl):.2f}" if fl else None,
+                   all(r["N_cut"] > r["n_total"] for r in fl)))
+    out.append(row("frictionless, undamped: E_dis,c = E_dis,tot (App. C.1, Fig. C.2c)", fl,
+                   f"E_dis,c / E_dis,tot {min(r['E_dis_c'] / r['E_dis_tot'] for r in fl):.4f}"
+                   if fl else None,
+                   all(abs(r["E_dis_c"] / r["E_dis_tot"] - 1) < 1e-9 for r in fl)))
+    a = pick("frictionless", 100.0, 0.0)
+    out.append(row("frictionless, undamped, head-on, 100 m/s: f_gro about -1 (App. C.1, "
+                   "Fig. B.1c)", a,
+                   ", ".join(f"{r['growth_efficiency']:+.3f}" for r in a),
+                   all(r["growth_efficiency"] < -0.5 for r in a)))
+    out.append(row("frictionless, undamped, head-on, 100 m/s: E_dis,tot significantly below "
+                   "E_imp (App. C.1, Fig. C.1c)", a,
+                   "E_dis,tot / E_imp " + ", ".join(f"{r['E_dis_tot']:.3f}" for r in a),
+                   all(r["E_dis_tot"] < 0.5 for r in a)))
+    fr = [r for r in pick("frictional, T_vis 6 ps") if r["E_dis_tot"]]
+    out.append(row("frictional models: E_dis,c / E_dis,tot << 1 (App. C.1)", fr,
+                   "E_dis,c / E_dis,tot " + ", ".join(f"{r['E_dis_c'] / r['E_dis_tot']:.3f}"
+                                                       for r in fr),
+                   all(r["E_dis_c"] / r["E_dis_tot"] < 0.1 for r in fr)))
+    return out
+
+
+def figure(summary: dict, results: Path) -> list[Path]:
+    """Per question and size: f_gro per B_off^2 (each seed, and seeds averaged) over
+    N_con / N_tot and N_cut / N_tot."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    cells = [(k, s) for k, by in summary.items() for s in by]
+    fig, axes = plt.subplots(2, len(cells), figsize=(3.6 * len(cells), 5.6), squeeze=False,
+                             sharex="col")
+    for col, (k, size) in enumerate(cells):
+        s, q = summary[k][size], QUESTIONS[k]
+        ax = axes[0, col]
+        for b, by_seed in s["f_gro_per_seed"].items():
+            ax.plot([float(b)] * len(by_seed), list(by_seed.values()), "o", color="0.6", ms=4)
+        ax.plot(s["B_off2"], s["f_gro"], "k-o", ms=4, label="seeds averaged")
+        if s.get("mean_f_gro"):
+            m = s["mean_f_gro"]
+            ax.axhline(m["mean"], color="C3", ls="--",
+                       label=f"<f_gro> (eq. 1) {m['mean']:+.3f} +- {m['se']:.3f}")
+        ax.axhline(0, color="0.8", lw=0.8)
+        ax.set_ylim(-1.05, 1.05)
+        ax.set_title(f"{k}: {q['model']}, {q['v_col']:g} m/s\n2 x {size}", fontsize=9)
+        ax.legend(fontsize=7)
+        ax = axes[1, col]
+        ax.plot(s["B_off2"], s["N_con_over_N_tot"], "o-", ms=4, label="N_con / N_tot")
+        ax.plot(s["B_off2"], s["N_cut_over_N_tot"], "s--", ms=4, label="N_cut / N_tot")
+        ax.axhline(1, color="0.8", lw=0.8)
+        ax.set_xlabel("B_off^2")
+        ax.legend(fontsize=7)
+    axes[0, 0].set_ylabel("f_gro (grey: one seed)")
+    axes[1, 0].set_ylabel("contacts made, cut / N_tot")
+    fig.tight_layout()
+    return save(fig, results, "fig_protocol")
+
+
+def summarise(records: Path, results: Path, plot: bool = True) -> dict:
+    outcomes = [o for o in load(records) if o.get("stop_reason") in COMPLETE]
+    rows = []
+    for o in outcomes:
+        r = scalars(o)
+        r.update(question=o["question"], model_name=next(
+            name for name, (kind, tvis, _) in MODELS.items()
+            if kind == o["model"] and tvis == (o.get("tvis") or 0.0)))
+        rows.append(r)
+    write_csv(results / "runs.csv", [{k: v for k, v in r.items() if k != "run"} for r in rows])
+    by = defaultdict(lambda: defaultdict(list))
+    for o in outcomes:
+        by[o["question"]][o["N_tar"]].append(o)
+    summary = {k: {n: question_summary(runs) for n, runs in sorted(by[k].items())}
+               for k in QUESTIONS if k in by}
+    done = dict(study="paper_protocol", protocol="the paper's offsets B_off^2 = k/12 "
+                "(k = 0 ... 11, 12/12 grazing taken as f_gro 0) for b and d; one offset for "
+                "a and c", questions={k: dict(QUESTIONS[k], b_off2=[round(b, 4) for b in
+                                                                     QUESTIONS[k]["b_off2"]])
+                                      for k in QUESTIONS},
+                records=str(records.relative_to(results)) if records.is_relative_to(results)
+                else str(records),
+                results=dict(by_question=summary, statements=statements(rows)))
+    if plot and summary:
+        done["figures"] = [p.name for p in figure(summary, results)]
+    return done
+
+
+def main(argv=None) -> int:
+    p = campaign_study_parser(__doc__)
+    p.add_argument("--stage", choices=sorted(STAGES), default="place")
+    p.add_argument("--questions", nargs="+", choices=sorted(QUESTIONS), default=None)
+    p.add_argument("--summary-only", action="store_true",
+                   help="run nothing: the results from the records kept so far")
+    args = p.parse_args(argv)
+    runs, results = study_paths(args, "paper_protocol")
+    records = results / "records"
+    stage = QUICK if args.quick else STAGES[args.stage]
+    if not args.summary_only:
+        for k in args.questions or list(QUESTIONS):
+            run_question(k, stage, runs, args.np)
+    return write_summary(results, summarise(records, results))
+
+
+if __name__ == "__main__":
+    sys.exit(main())
