@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from jkrdt import rundir
+from jkrdt.protocol import offset_label
 from jkrdt.rundir import read_thermo, run_status
 from jkrdt.ledger import CHANNELS, contact_events, energy_budget, energy_error
 from jkrdt.stopping import ENERGY_WARN, STOP_WORDS
@@ -145,7 +146,7 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
     write_csv(run / rundir.FRAMES, rows)
     if plots:
         title = (f"{mat.name} {scene.kind.upper()} {n_tar}+{n_pro}, "
-                 f"v = {scene.v_col:g} m/s, B_off = {scene.b_off:g}, {scene.model}"
+                 f"v = {scene.v_col:g} m/s, {offset_label(scene.b_off)}, {scene.model}"
                  + (f", T_vis = {mat.tvis * 1e12:g} ps" if mat.tvis > 0 else ""))
         when = f"{status.stop_reason} at step {last_step}"
         if "time_end" in out:

@@ -206,7 +206,10 @@ def figure(summary: dict, results: Path) -> list[Path]:
                        label=f"<f_gro> (eq. 1) {m['mean']:+.3f} +- {m['se']:.3f}")
         ax.axhline(0, color="0.8", lw=0.8)
         ax.set_ylim(-1.05, 1.05)
-        ax.set_title(f"{k}: {q['model']}, {q['v_col']:g} m/s\n2 x {size}", fontsize=9)
+        ax.set_xlim(-0.03, 1.03)
+        ax.set_xticks([k / 12 for k in range(0, 13, 3)], ["0", "3/12", "6/12", "9/12", "1"])
+        ax.set_title(f"{k}: {q['model']}, {q['v_col']:g} m/s, 2 x {size}\npaper: "
+                     f"{q['paper'].split(' (')[0]}", fontsize=8)
         ax.legend(fontsize=7)
         ax = axes[1, col]
         ax.plot(s["B_off2"], s["N_con_over_N_tot"], "o-", ms=4, label="N_con / N_tot")

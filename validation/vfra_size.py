@@ -62,8 +62,8 @@ from bpca3d_models import FULL as SMALLER_PLAN, MODELS, model_spec
 from common import (HERE, campaign_paths, campaign_study_parser, loop_ranks, loop_seconds,
                     read_committed, run_campaigns, save, study_paths)
 from jkrdt import rundir
-from jkrdt.analysis.summary import (b_off_average, b_off_groups, b_off_mean,
-                                    threshold_velocity)
+from jkrdt.analysis.summary import (DIAGNOSTICS, b_off_average, b_off_groups, b_off_mean,
+                                    diagnostics, threshold_velocity)
 from jkrdt.analysis.tables import read_csv, write_csv
 from jkrdt.stopping import COMPLETE
 
@@ -150,7 +150,9 @@ def seed_spread(rows: list[dict]) -> list[float]:
 
 
 def outcome_rows(home: Path, n: int, model: str) -> list[dict]:
-    """One row per finished run below ``home``, with its loop time and its dt. A run is
+    """One row per finished run below ``home``, with its loop time, its dt and the paper's
+    diagnostics (``analysis.summary.diagnostics``; rows of the ledger from before they
+    were recorded leave them empty). A run is
     read where its outcome lies (the path an outcome records may be relative to where its
     campaign was started)."""
     return [dict(size=n, model=model, loop_seconds=loop_seconds(p.parent),
@@ -159,12 +161,13 @@ def outcome_rows(home: Path, n: int, model: str) -> list[dict]:
                  **{k: o.get(k) for k in (
                      "v_col", "B_off", "seed", "n_total", "n_largest", "n_fragments",
                      "growth_efficiency", "stop_reason", "stop_step", "time_end_over_tc",
-                     "energy_error", "kinetic_left")})
+                     "energy_error", "kinetic_left")}, **diagnostics(o))
             for p in sorted(home.rglob(rundir.OUTCOME)) for o in [json.loads(p.read_text())]]
 
 
 #: the columns of runs.csv that hold whole numbers
-INTS = ("size", "seed", "n_total", "n_largest", "n_fragments", "stop_step", "ranks")
+INTS = ("size", "seed", "n_total", "n_largest", "n_fragments", "stop_step", "ranks",
+        *(k for k in DIAGNOSTICS if k.startswith("N_cum_")))
 
 
 def core_hours(rows: list[dict]) -> float:

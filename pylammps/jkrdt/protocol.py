@@ -36,6 +36,12 @@ def grazing_cumulative(n, n_tar: int, n_pro: int):
     return n_tar * (n >= n_tar) + n_pro * (n >= n_pro)
 
 
+def offset_label(b_off: float) -> str:
+    """B_off as the paper names it: "B_off^2 = k/12" on its grid, else "B_off = x"."""
+    k = 12 * b_off ** 2
+    return f"B_off^2 = {round(k)}/12" if abs(k - round(k)) < 1e-6 else f"B_off = {b_off:g}"
+
+
 def is_paper_grid(b_off2) -> bool:
     """Whether ``b_off2`` (the B_off^2 values of runs) is the paper's grid less its grazing
     end: then eq. (1) adds the grazing point."""
