@@ -293,6 +293,9 @@ def test_the_offset_grid_study_averages_the_papers_twelfths_and_the_four(tmp_pat
         np.trapezoid([f[0], f[3], f[6], f[9], f[9]], [0, 0.25, 0.5, 0.75, 1.0]), abs=1e-12)
 
 
+ICE_TC = scales(ICE, 1.0e-7).t_c
+
+
 def test_the_paper_protocol_study_averages_twelve_offsets_and_keeps_every_record(tmp_path):
     # validation/paper_protocol.py --quick, questions a and b: 2 x 24 frictionless ice
     # BPCAs, seeds 1 and 2, head-on at 100 m/s (the paper's f_gro about -1: far above this
@@ -324,6 +327,11 @@ def test_the_paper_protocol_study_averages_twelve_offsets_and_keeps_every_record
     for o in map(json.loads, (p.read_text() for p in (results / "records").rglob(
             "outcome.json"))):
         assert o["N_con"] - o["N_cut"] == o["contacts_end"] - o["contacts_start"]
+    # f_gro read from each run's settle checks at the paper's snapshot times: after the run
+    # has settled it is the outcome's
+    for r in runs:
+        if r["time_end_over_tc"] * ICE_TC < 1.6e-6:
+            assert r["f_gro_at_1.6_us"] == r["growth_efficiency"]
     rows = {s["paper"].split(" (")[0]: s for s in summary["statements"]}
     assert rows["frictionless, undamped: E_dis,c = E_dis,tot"]["holds"]
     # the runs gone, the records alone give the same results

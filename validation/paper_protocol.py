@@ -28,8 +28,9 @@ RESULTS/records/<campaign>/v<v_col>/b2_<B_off^2>/seed<k>/ as its campaign ends, 
 results are made from those records alone:
 runs.csv (every run, its diagnostics among the columns), summary.json (per question: f_gro
 per offset and seed, <f_gro> by eq. 1 with its seed scatter where the twelve offsets ran,
-the diagnostics' eq. 1 means; the paper's statements of App. C against the runs, one row
-each) and fig_protocol (f_gro, N_con / N_tot and N_cut / N_tot against B_off^2).
+the diagnostics' eq. 1 means, and f_gro at the paper's snapshot times 0.4-1.6 us read
+from each run's settle checks, to show whether where a run ends moves it; the paper's
+statements of App. C against the runs, one row each) and fig_protocol (f_gro, N_con / N_tot and N_cut / N_tot against B_off^2).
 
     ./run validate paper_protocol                   # --stage place: 2 x 5000, hours
     ./run validate paper_protocol --questions a c
@@ -52,7 +53,7 @@ from common import campaign_study_parser, run_campaigns, save, study_paths, writ
 from jkrdt import protocol, rundir
 from jkrdt.analysis.summary import (DIAGNOSTICS, b_off_groups, diagnostics, mean_diagnostic,
                                     seed_scatter, scalars)
-from jkrdt.analysis.tables import write_csv
+from jkrdt.analysis.tables import read_csv, write_csv
 from jkrdt.stopping import COMPLETE
 from vfra_size import TOLERANCE
 
@@ -103,12 +104,30 @@ def question_of(record: Path, records: Path) -> tuple[int, str]:
     return int(size[1:]), question
 
 
+#: the times (us from the start) at which f_gro is read from each run's checks as well as at
+#: its end: the paper's snapshots are 0.4 us apart (its Fig. 1), and its runs' end is not
+#: stated, so these show whether when a run ends moves f_gro
+SNAPSHOTS_US = (0.4, 0.8, 1.2, 1.6)
+
+
+def f_gro_at(record: Path, n_tar: int, n_pro: int) -> dict[str, float | None]:
+    """f_gro = (N_lar - N_tar) / N_pro at SNAPSHOTS_US from the run's settle checks (the
+    last check at or before each time; the settled value after the run's end)."""
+    rows = read_csv(record / rundir.CHECKS)
+    out = {}
+    for t in SNAPSHOTS_US:
+        before = [r for r in rows if r["time"] <= t * 1e-6 * (1 + 1e-9)]
+        out[f"{t:g}"] = (before[-1]["n_largest"] - n_tar) / n_pro if before else None
+    return out
+
+
 def load(records: Path) -> list[dict]:
-    """Every kept record's outcome, with its size, question and loop time."""
+    """Every kept record's outcome, with its size, question and f_gro at SNAPSHOTS_US."""
     out = []
     for path in sorted(records.rglob(rundir.OUTCOME)):
         o = json.loads(path.read_text())
         o["n"], o["question"] = question_of(path.parent, records)
+        o["f_gro_at_us"] = f_gro_at(path.parent, o["N_tar"], o["N_pro"])
         out.append(o)
     return out
 
@@ -129,9 +148,16 @@ def question_summary(runs: list[dict]) -> dict:
                f_gro_per_seed=dict(per_seed), N_con_over_N_tot=[float(x) for x in con],
                N_cut_over_N_tot=[float(x) for x in cut],
                paper_grid=protocol.is_paper_grid(b2))
+    at = {t: b_off_groups(runs, lambda o: o["f_gro_at_us"][t])[1]
+          for t in runs[0]["f_gro_at_us"]
+          if all(o["f_gro_at_us"][t] is not None for o in runs)}
+    out["f_gro_at_us"] = {t: [float(x) for x in f] for t, f in at.items()}
     if out["paper_grid"]:
         out["mean_f_gro"] = seed_scatter(runs, f_gro, protocol.GRAZING["growth_efficiency"])
         out["means"] = {k: mean_diagnostic(runs, k) for k in DIAGNOSTICS}
+        out["mean_f_gro_at_us"] = {
+            t: seed_scatter(runs, lambda o: o["f_gro_at_us"][t],
+                            protocol.GRAZING["growth_efficiency"])["mean"] for t in at}
     return out
 
 
@@ -228,6 +254,8 @@ def summarise(records: Path, results: Path, plot: bool = True) -> dict:
     rows = []
     for o in outcomes:
         r = scalars(o)
+        r.update(time_end_over_tc=o.get("time_end_over_tc"),
+                 **{f"f_gro_at_{t}_us": f for t, f in o["f_gro_at_us"].items()})
         r.update(question=o["question"], model_name=next(
             name for name, (kind, tvis, _) in MODELS.items()
             if kind == o["model"] and tvis == (o.get("tvis") or 0.0)))
