@@ -245,6 +245,8 @@ def figure(summary: dict, results: Path) -> list[Path]:
             ax.plot([float(b)] * len(by_seed), list(by_seed.values()), "o", color="0.6", ms=4)
         ax.plot(s["B_off2"], s["f_gro"], "k-o", ms=4, label="seeds averaged")
         if s.get("mean_f_gro"):
+            ax.plot([1.0], [protocol.GRAZING["growth_efficiency"]], "o", mfc="none",
+                    color="k", ms=5, label="12/12 grazes: taken as 0")
             m = s["mean_f_gro"]
             ax.axhline(m["mean"], color="C3", ls="--",
                        label=f"<f_gro> (eq. 1) {m['mean']:+.3f} +- {m['se']:.3f}")
