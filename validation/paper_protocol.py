@@ -142,8 +142,11 @@ def question_summary(runs: list[dict]) -> dict:
     per_seed = defaultdict(dict)
     for o in runs:
         per_seed[f"{o['B_off'] ** 2:.4f}"][o["seed"]] = o["growth_efficiency"]
-    _, con = b_off_groups(runs, lambda o: (o.get("N_con") or np.nan) / n_tot)
-    _, cut = b_off_groups(runs, lambda o: (o.get("N_cut") or np.nan) / n_tot)
+    def per_grain(name):    # NaN for a record without the count, 0 for a collision that missed
+        return lambda o: (np.nan if o.get(name) is None else o[name]) / n_tot
+
+    _, con = b_off_groups(runs, per_grain("N_con"))
+    _, cut = b_off_groups(runs, per_grain("N_cut"))
     out = dict(runs=len(runs), B_off2=[float(b) for b in b2], f_gro=[float(x) for x in f],
                f_gro_per_seed=dict(per_seed), N_con_over_N_tot=[float(x) for x in con],
                N_cut_over_N_tot=[float(x) for x in cut],
