@@ -140,7 +140,7 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
                                           for name in CHANNELS})
         # N_con, N_cut (3D BPCA paper, App. C.2) at the analysed end; the bonded contacts
         # then less those at the start are N_con - N_cut exactly
-        events = contact_events({k: v[:end + 1] for k, v in thermo.items()})
+        events = contact_events(thermo, end)
         if events is not None:
             out.update(events)
     write_csv(run / rundir.FRAMES, rows)

@@ -118,9 +118,7 @@ def offset_table_text(table: dict) -> str:
         lines.append(f"f_gro by B_off^2 and v_col (m/s), {name} (the paper's Fig. B.1):")
         lines.append("B_off^2 " + "".join(f"{v:>8}" for v in speeds))
         for b, row in rows.items():
-            k = float(b) * 12
-            name_b = f"{round(k)}/12" if abs(k - round(k)) < 1e-3 else b
-            lines.append(f"{name_b:<8}" + "".join(
+            lines.append(f"{protocol.twelfths(float(b)) or b:<8}" + "".join(
                 f"{row[v]:+8.3f}" if v in row else f"{'':>8}" for v in speeds))
     return "\n".join(lines)
 
@@ -160,16 +158,21 @@ def diagnostics(out: dict) -> dict:
                 **{f"N_cum_{n}": None if c is None else int(c) for n, c in zip(N_CUM_AT, at)})
 
 
-def mean_diagnostic(runs, name: str) -> float | None:
-    """<A> of eq. (1) of one of the paper's diagnostics (``DIAGNOSTICS``) over ``runs``,
-    the grazing offset adding nothing; None where a run lacks it."""
-    values = [diagnostics(o)[name] for o in runs]
-    if any(v is None for v in values):
-        return None
-    grazing = (protocol.grazing_cumulative(int(name.split("_")[-1]), runs[0]["N_tar"],
-                                           runs[0]["N_pro"])
-               if name.startswith("N_cum_") else 0.0)
-    return float(b_off_mean(runs, lambda o: diagnostics(o)[name], grazing))
+def mean_diagnostics(runs) -> dict[str, float | None]:
+    """<A> of eq. (1) of each of the paper's diagnostics (``DIAGNOSTICS``) over ``runs``
+    (each run's diagnostics taken once); at the grazing offset nothing is made, cut or
+    dissipated and N_cum is the two aggregates whole. None where a run lacks one."""
+    each = [dict(B_off=o["B_off"], **diagnostics(o)) for o in runs]
+    out = {}
+    for name in DIAGNOSTICS:
+        if any(d[name] is None for d in each):
+            out[name] = None
+            continue
+        grazing = (protocol.grazing_cumulative(int(name.split("_")[-1]), runs[0]["N_tar"],
+                                               runs[0]["N_pro"])
+                   if name.startswith("N_cum_") else 0.0)
+        out[name] = float(b_off_mean(each, lambda d: d[name], grazing))
+    return out
 
 
 def scalars(out: dict) -> dict:
@@ -243,7 +246,7 @@ def summarise(campaign, plot: bool = True, include_cap: bool = False) -> dict:
                           mean_N_lar_over_N_total=float(b_off_mean(
                               runs, lambda o: o["n_largest"] / o["n_total"],
                               g["N_lar_over_N_total"])),
-                          **{f"mean_{k}": mean_diagnostic(runs, k) for k in DIAGNOSTICS},
+                          **{f"mean_{k}": m for k, m in mean_diagnostics(runs).items()},
                           E_imp_over_nk_Ebreak=runs[0]["E_imp_over_nk_Ebreak"]))
         curves[name][0].append(v)
         curves[name][1].append(mean_f)

@@ -44,7 +44,7 @@
    one column per channel, and of the contacts made and cut; half of each
    contact's dissipation and events goes to each of its two atoms. The
    ledger sums to values 5-9, 11 and 12 of compute pair jkr/dt, survives
-   migration and restarts, and is the fix's per-atom array.                                                          */
+   migration and restarts, and is the fix's per-atom array.                 */
 
 #ifndef JKR_DT_FIX_CONTACTS_H
 #define JKR_DT_FIX_CONTACTS_H

@@ -51,8 +51,7 @@ import numpy as np
 from bpca3d_models import MODELS, model_spec
 from common import campaign_study_parser, run_campaigns, save, study_paths, write_summary
 from jkrdt import protocol, rundir
-from jkrdt.analysis.summary import (DIAGNOSTICS, b_off_groups, diagnostics, mean_diagnostic,
-                                    seed_scatter, scalars)
+from jkrdt.analysis.summary import b_off_groups, mean_diagnostics, scalars, seed_scatter
 from jkrdt.analysis.tables import read_csv, write_csv
 from jkrdt.stopping import COMPLETE
 from vfra_size import TOLERANCE
@@ -157,7 +156,7 @@ def question_summary(runs: list[dict]) -> dict:
     out["f_gro_at_us"] = {t: [float(x) for x in f] for t, f in at.items()}
     if out["paper_grid"]:
         out["mean_f_gro"] = seed_scatter(runs, f_gro, protocol.GRAZING["growth_efficiency"])
-        out["means"] = {k: mean_diagnostic(runs, k) for k in DIAGNOSTICS}
+        out["means"] = mean_diagnostics(runs)
         out["mean_f_gro_at_us"] = {
             t: seed_scatter(runs, lambda o: o["f_gro_at_us"][t],
                             protocol.GRAZING["growth_efficiency"])["mean"] for t in at}

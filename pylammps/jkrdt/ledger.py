@@ -77,13 +77,13 @@ def energy_error(budget: dict[str, np.ndarray], e_imp: float) -> float:
     return float(np.abs(total - total[0]).max() / e_imp)
 
 
-def contact_events(thermo: dict[str, np.ndarray]) -> dict[str, float] | None:
-    """N_con and N_cut at the last row of thermo columns named as in ``THERMO`` (whole
+def contact_events(thermo: dict[str, np.ndarray], at: int = -1) -> dict[str, float] | None:
+    """N_con and N_cut at row ``at`` of thermo columns named as in ``THERMO`` (whole
     numbers: the plugin books half an event to each atom), with the bonded contacts at the
-    first and last rows, whose difference they equal; None for a log written before the
-    plugin counted them."""
+    first row and at that one, whose difference they equal; None for a log written before
+    the plugin counted them."""
     if MADE not in thermo or CUT not in thermo:
         return None
-    return dict(N_con=float(thermo[MADE][-1]), N_cut=float(thermo[CUT][-1]),
+    return dict(N_con=float(thermo[MADE][at]), N_cut=float(thermo[CUT][at]),
                 contacts_start=float(thermo[CONTACTS][0]),
-                contacts_end=float(thermo[CONTACTS][-1]))
+                contacts_end=float(thermo[CONTACTS][at]))

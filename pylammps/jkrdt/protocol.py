@@ -22,10 +22,10 @@ PAPER = "paper"
 B_OFF2 = [k / 12 for k in range(12)]
 #: the paper's speeds, 10^(0.1 i) m/s for i = 10 ... 20 (10 to 100 m/s)
 V_COL = [round(10 ** (0.1 * i), 1) for i in range(10, 21)]
-#: at B_off^2 = 1 the aggregates graze: what a collision that does not happen gives
-#: (f_gro 0, the target alone the largest of two equal aggregates, nothing made, cut or
-#: dissipated; N_cum: ``grazing_cumulative``)
-GRAZING = dict(growth_efficiency=0.0, N_lar_over_N_total=0.5, N_con=0.0, N_cut=0.0, E_dis=0.0)
+#: at B_off^2 = 1 the aggregates graze: what a collision that does not happen gives (f_gro
+#: 0, the target alone the largest of two equal aggregates); nothing is made, cut or
+#: dissipated there (0), and N_cum is ``grazing_cumulative``
+GRAZING = dict(growth_efficiency=0.0, N_lar_over_N_total=0.5)
 
 
 def grazing_cumulative(n, n_tar: int, n_pro: int):
@@ -36,10 +36,16 @@ def grazing_cumulative(n, n_tar: int, n_pro: int):
     return n_tar * (n >= n_tar) + n_pro * (n >= n_pro)
 
 
+def twelfths(b_off2: float) -> str | None:
+    """B_off^2 as the paper writes it, "k/12", where it is a twelfth; else None."""
+    k = 12 * b_off2
+    return f"{round(k)}/12" if abs(k - round(k)) < 1e-6 else None
+
+
 def offset_label(b_off: float) -> str:
     """B_off as the paper names it: "B_off^2 = k/12" on its grid, else "B_off = x"."""
-    k = 12 * b_off ** 2
-    return f"B_off^2 = {round(k)}/12" if abs(k - round(k)) < 1e-6 else f"B_off = {b_off:g}"
+    k = twelfths(b_off ** 2)
+    return f"B_off^2 = {k}" if k else f"B_off = {b_off:g}"
 
 
 def is_paper_grid(b_off2) -> bool:
