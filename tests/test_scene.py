@@ -51,6 +51,37 @@ def test_a_written_scene_reads_back_and_holds_its_impact_energy(tmp_path):
     assert deck.endswith(rundir.find_template().read_text())
 
 
+def test_the_set_ups_open_choices_place_bonds_and_gap_as_asked(tmp_path):
+    # bonds at delta_0 (the JKR equilibrium, at rest) or touching (1e-3 delta_0, inside
+    # contact: no bond lost); the gap is the distance between the nearest grains of the two
+    # aggregates at the start; both read back from collision.json
+    from scipy.spatial import cKDTree
+
+    from jkrdt.scene import BONDS
+
+    r = 1.0e-7
+    for bond in BONDS:
+        scene = Scene(ICE, 60, 40, v_col=10.0, seed=5, model="frictionless", bond=bond,
+                      gap=2.0e-8)
+        placed = scene.collide()
+        x, body = placed.x, placed.body
+        delta = BONDS[bond] * scene.scales.delta0
+        for b in (1, 2):
+            pairs = cKDTree(x[body == b]).query_pairs(2 * r + 1e-3 * scene.scales.delta0,
+                                                      output_type="ndarray")
+            d = np.linalg.norm(np.diff(x[body == b][pairs], axis=1)[:, 0], axis=1)
+            assert len(pairs) >= (body == b).sum() - 1         # a tree of bonds at least
+            assert np.abs(d - (2 * r - delta)).max() < 1e-6 * scene.scales.delta0
+        nearest = cKDTree(x[body == 1]).query(x[body == 2])[0].min()
+        assert nearest - 2 * r == pytest.approx(2.0e-8, rel=1e-9)
+        rundir.write(tmp_path / bond, scene, placed)
+        assert rundir.read(tmp_path / bond) == scene
+    with pytest.raises(ValueError, match="unknown bond 'glued'"):
+        Scene(ICE, 8, 8, v_col=1.0, bond="glued")
+    with pytest.raises(ValueError, match="initial gap must be >= 0 m"):
+        Scene(ICE, 8, 8, v_col=1.0, gap=-1e-9)
+
+
 def test_committed_scene_decks_are_what_the_scene_module_writes(tmp_path):
     for name in ("bcca_2d_head_on", "bpca_3d_oblique"):
         committed = ROOT / "inputs" / "data" / name

@@ -7,13 +7,14 @@ A spec (JSON) names the grid and the scene:
      "material_overrides": {"tvis": 6e-12}, "radius": 1e-7, "model": "frictional",
      "v_col": [10, 20, 40], "b_off2": [0, 0.25, 0.5, 0.75], "seeds": [1],
      "dt": 0.014, "settle": {"check_tc": 50, "window": 5, "tolerance": 0.01,
-                             "counts": 1e-4, "cap_tc": 40000}}
+                             "counts": 1e-4, "cap_tc": 40000}, "bond": null, "gap": null}
 
 n_tar, n_pro, v_col and b_off2 are required; ``"v_col": "paper"`` and ``"b_off2": "paper"``
 are the 3D BPCA paper's grids (``jkrdt.protocol``: 10^(0.1 i) m/s for i = 10 ... 20, and
 B_off^2 = k/12 for k = 0 ... 11, the grazing 12/12 taken as no collision); the other keys default to the values above
 (material_overrides {}, settle {} = the settle rule's defaults), and any Material field
-can be overridden in material_overrides. "dt" is in units of t_c, or "auto": each speed's
+can be overridden in material_overrides. "bond" and "gap" are the set-up's choices of
+``jkrdt.scene.Scene`` (null: bonds at delta_0, a gap of delta_c / 2). "dt" is in units of t_c, or "auto": each speed's
 dt then comes from "tolerance" (max |dE| / E_imp, default 1e-4) as ``jkrdt setup --dt auto
 --tolerance`` chooses it (``jkrdt.timestep``).
 
@@ -61,13 +62,13 @@ from . import __version__
 from . import protocol, rundir
 from .aggregates import BUILDERS
 from .materials import material
-from .scene import Scene
+from .scene import BONDS, Scene
 from .stopping import SettleRule
 from .timestep import AUTO_TOLERANCE, DT_STABLE
 
 DEFAULTS = dict(kind="bpca", dim=3, material="ice", material_overrides={}, radius=1.0e-7,
                 model="frictional", seeds=[1], dt=0.014, tolerance=None, settle={},
-                steps=None, every=None)
+                steps=None, every=None, bond=None, gap=None)
 REQUIRED = ["n_tar", "n_pro", "v_col", "b_off2"]
 
 
@@ -100,6 +101,9 @@ CHECKS = {
                   "a relative energy error in (0, 1) that dt \"auto\" is chosen for"),
     "steps": (lambda x: x is None or (_whole(x) and x >= 1), "a whole number of steps >= 1"),
     "every": (lambda x: x is None or (_whole(x) and x >= 1), "a whole number of steps >= 1"),
+    "bond": (lambda x: x is None or x in BONDS, f"null or one of {sorted(BONDS)}"),
+    "gap": (lambda x: x is None or (_number(x) and x >= 0),
+            "null (delta_c / 2) or the aggregates' initial gap >= 0 in m"),
     "settle": (lambda x: isinstance(x, (bool, dict)), "true, false or an object of SettleRule "
                "fields"),
 }
@@ -265,6 +269,7 @@ def scene_of(spec: dict, v: float, b2: float, seed: int) -> Scene:
                   n_tar=spec["n_tar"], n_pro=spec["n_pro"], v_col=v, b_off=float(np.sqrt(b2)),
                   seed=seed, kind=spec["kind"], dim=spec["dim"], radius=spec["radius"],
                   model=spec["model"], dt_over_tc=None if auto else spec["dt"],
+                  bond=spec["bond"] or "equilibrium", gap=spec["gap"],
                   dt_reason=None if auto else f"dt = {spec['dt']:g} t_c, the campaign's")
     return scene.with_dt_for(spec["tolerance"]) if auto else scene
 

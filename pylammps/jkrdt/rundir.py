@@ -106,6 +106,10 @@ def metadata(scene: Scene) -> dict:
     if scene.dt_over_tc is not None:
         meta.update(dt_over_tc=scene.dt_over_tc, dt_reason=scene.dt_reason)
     meta.update(skin=scene.skin_for(scene.time_step()[0]), skin_given=scene.skin is not None)
+    if scene.bond != "equilibrium":
+        meta.update(bond=scene.bond)
+    if scene.gap is not None:
+        meta.update(gap_given=scene.gap)
     return meta
 
 
@@ -117,7 +121,8 @@ def from_metadata(meta: dict) -> Scene:
                  dim=meta["dimension"], radius=meta["radius"],
                  model=meta.get("model") or "frictional", dt_over_tc=meta.get("dt_over_tc"),
                  dt_reason=meta.get("dt_reason"),
-                 skin=meta["skin"] if meta.get("skin_given") else None)
+                 skin=meta["skin"] if meta.get("skin_given") else None,
+                 bond=meta.get("bond", "equilibrium"), gap=meta.get("gap_given"))
 
 
 def read_metadata(directory) -> dict:

@@ -3,7 +3,9 @@
 A scene is the material and grain radius, the dimension, the model ('frictional':
 Wada et al. 2007 with the material's xi_crit; 'frictionless': the 3D BPCA paper's
 model without sliding, rolling and twisting), the aggregates' kind and sizes, v_col,
-B_off, the seed, the time step and the neighbor skin. It is a value: how it is written
+B_off, the seed, the time step and the neighbor skin, and two choices of the set-up that
+the papers leave open (``bond``: the aggregates' bonds at the JKR equilibrium delta_0, as
+built by default, or touching; ``gap``: how far apart the aggregates start). It is a value: how it is written
 into a directory, read back and run (``collision.json``, the deck and its variables) is
 ``jkrdt.rundir``'s.
 
@@ -24,6 +26,10 @@ from .materials import Material, scales
 from .timestep import PAPER_DT
 
 MODELS = ("frictional", "frictionless")
+#: where the aggregates' bonds sit, as a fraction of delta_0: at the JKR equilibrium (at
+#: rest, the default), or touching (delta 1e-3 delta_0, just inside contact: each bond then
+#: pulls with about 0.9 F_c and the aggregates start with the energy of settling into it)
+BONDS = {"equilibrium": 1.0, "touching": 1.0e-3}
 
 
 def pair_coeff(mat: Material, model: str = "frictional") -> str:
@@ -73,6 +79,8 @@ class Scene:
     dt_over_tc: float | None = None
     dt_reason: str | None = None
     skin: float | None = None       # m; None: from the speed and dt (skin_for)
+    bond: str = "equilibrium"       # one of BONDS
+    gap: float | None = None        # m between the nearest grains at the start; None: delta_c/2
 
     def __post_init__(self):
         if not self.v_col > 0:
@@ -93,6 +101,10 @@ class Scene:
         check_fits(self.n_tar + self.n_pro)
         if self.dt_over_tc is not None:
             timestep.check(self.dt_over_tc)
+        if self.bond not in BONDS:
+            raise ValueError(f"unknown bond {self.bond!r}: one of {sorted(BONDS)}")
+        if self.gap is not None and not self.gap >= 0:
+            raise ValueError(f"the initial gap must be >= 0 m (got {self.gap:g})")
         pair_coeff(self.material, self.model)          # the model fits the material
 
     @functools.cached_property
@@ -148,7 +160,8 @@ class Scene:
         scene's seed, so the same for every v_col and B_off)."""
         rng = np.random.default_rng(self.seed) if rng is None else rng
         build = BUILDERS[self.kind]
-        return tuple(build(n, self.radius, self.scales.delta0, rng, dim=self.dim)
+        delta = BONDS[self.bond] * self.scales.delta0
+        return tuple(build(n, self.radius, delta, rng, dim=self.dim)
                      for n in (self.n_tar, self.n_pro))
 
     def collide(self, aggregates=None, rng=None) -> collision.Collision:
@@ -163,4 +176,5 @@ class Scene:
         if tuple(map(len, aggregates)) != (self.n_tar, self.n_pro):
             raise ValueError("the aggregates do not have the scene's n_tar and n_pro grains")
         return collision.set_up(*aggregates, self.radius, v_col=self.v_col, b_off=self.b_off,
-                                rng=rng, delta_c=self.scales.delta_c, dim=self.dim)
+                                rng=rng, delta_c=self.scales.delta_c, gap=self.gap,
+                                dim=self.dim)
