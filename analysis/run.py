@@ -97,6 +97,9 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
                 row["time"] = float(thermo["Time"][at[0]])
                 row.update({name: float(budget[name][at[0]]) for name in
                             ["kinetic", "potential", "dissipated", *CHANNELS]})
+                events = contact_events(thermo, int(at[0]))
+                if events is not None:            # N_con, N_cut so far (App. C.2)
+                    row.update(N_con=events["N_con"], N_cut=events["N_cut"])
     if not dumped:
         raise ValueError(f"{atoms} has no frames"
                          + (f" ({status.problem})" if status.problem else ""))

@@ -110,6 +110,11 @@ def test_frames_table_matches_the_session(run):
             assert r[name] == pytest.approx(energies[name][k], rel=1e-9, abs=1e-9 * out["E_imp"])
     assert rows[-1]["n_largest"] == out["n_largest"]
     assert rows[0]["n_fragments"] == 2 and rows[0]["growth_efficiency"] == 0.0
+    # N_con and N_cut at every check, none at the start, the outcome's at the end
+    assert rows[0]["N_con"] == rows[0]["N_cut"] == 0
+    assert (rows[-1]["N_con"], rows[-1]["N_cut"]) == (out["N_con"], out["N_cut"])
+    assert all(a["N_con"] <= b["N_con"] and a["N_cut"] <= b["N_cut"]
+               for a, b in zip(rows, rows[1:]))
 
 
 def test_local_dump_stream(run):

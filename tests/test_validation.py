@@ -346,44 +346,54 @@ def test_the_paper_protocol_study_averages_twelve_offsets_and_keeps_every_record
 
 
 def test_the_size_trend_study_compares_each_candidate_with_base_on_the_same_seeds(tmp_path):
-    # validation/size_trend.py --quick: 2 x 24 frictionless ice BPCAs at 39.8 m/s, B_off^2
-    # 0 and 1/12, seeds 1 and 2, in four arms. Each arm changes one thing: dt 0.014 t_c
-    # runs at 0.014, base at timestep.choose's step; touching starts with every bond in
-    # contact (none lost: 2 (N - 1) contacts in two trees) and its ledger still closes;
-    # f_near is the eq. (1)-weighted mean of the offsets per seed, compared by
-    # common.within_scatter; f_gro at the snapshot times of a run settled before them is
-    # its outcome's
+    # validation/size_trend.py --quick: 2 x 24 ice BPCAs, B_off^2 0 and 1/12, seeds 1 and
+    # 2; frictionless at 39.8 m/s in four arms, frictional at 63.1 m/s in two. Each arm
+    # changes one thing: dt 0.014 t_c runs at 0.014, base at timestep.choose's step;
+    # touching starts with every bond in contact (none lost: 2 (N - 1) contacts in two
+    # trees) and its ledger still closes; f_near is the eq. (1)-weighted mean of the
+    # offsets per seed, compared by common.within_scatter; f_gro at the snapshot times of a
+    # run settled before them is its outcome's
     from jkrdt import timestep
 
     results = run_quick("size_trend", tmp_path)
     summary = json.loads((results / "summary.json").read_text())
     runs = read_csv(results / "runs.csv")
-    assert len(runs) == 4 * 2 * 2 and summary["runs_finished"] == 16
+    assert len(runs) == (4 + 2) * 2 * 2 and summary["runs_finished"] == 24
     assert max(r["energy_error"] for r in runs) < 1e-3
+    trend = [r for r in runs if r["question"] == "frictionless_39.8"]
     want, _ = timestep.choose(1e-3, 39.8, scales(ICE, 1e-7).v0, model="frictionless",
                               n_total=48, damped=False)
-    steps = {arm: {r["dt_over_tc"] for r in runs if r["arm"] == arm}
+    steps = {arm: {r["dt_over_tc"] for r in trend if r["arm"] == arm}
              for arm in ("base", "dt_0.014", "touching")}
     assert steps["dt_0.014"] == {0.014}
     assert len(steps["base"]) == 1 and steps["base"] == steps["touching"]
     assert steps["base"].pop() == pytest.approx(want, rel=1e-12)
-    for checks in (results / "records" / "touching").rglob("checks.csv"):
+    for checks in (results / "records" / "frictionless_39.8" / "touching").rglob("checks.csv"):
         assert read_csv(checks)[0]["contacts"] == 2 * (24 - 1)
-    for arm, folder in (("base", "base"), ("touching", "touching")):
+    asked = summary["asked"]["frictionless 39.8"]
+    for arm in ("base", "touching"):
         per_seed = []
         for seed in (1, 2):
-            f = {r["b2_twelfths"]: r["f_gro"] for r in runs
-                 if r["arm"] == folder and r["seed"] == seed}
+            f = {r["b2_twelfths"]: r["f_gro"] for r in trend
+                 if r["arm"] == arm and r["seed"] == seed}
             per_seed.append((0.5 * f[0] + f[1]) / 1.5)
-        got = summary["arms"][arm]["f_near"]
+        got = asked["arms"][arm]["f_near"]
         assert got[0] == pytest.approx(np.mean(per_seed), abs=1e-12)
         assert got[1] == pytest.approx(abs(per_seed[0] - per_seed[1]) / 2, abs=1e-12)
-    t = summary["results"]["touching"]
+    t = summary["results"]["frictionless 39.8"]["touching"]
     assert t["agree"] == (abs(t["difference"]) <= 2 * t["se"] + 1e-12)
     assert t["mean_f_gro_difference"] == pytest.approx(t["difference"] * 3.5 / 12)
+    assert set(summary["results"]["frictional 63.1"]) >= {"dt 0.014"}
     for r in runs:
         if r["time_end_over_tc"] * ICE_TC < 1.6e-6:
             assert r["f_gro_at_1.6_us"] == r["f_gro"]
+    # the dissipation table: each base run's E_dis / E_imp and N_con / N_tot, as recorded
+    table = summary["dissipation_by_size"]["24"]["0/12"]
+    mine = [json.loads(p.read_text()) for p in (results / "records" / "frictionless_39.8" /
+                                                 "base").rglob("outcome.json")]
+    mine = [o for o in mine if o["B_off"] == 0]
+    assert table["E_dis"] == pytest.approx(np.mean([o["dissipated_fraction"] for o in mine]))
+    assert table["N_con"] == pytest.approx(np.mean([o["N_con"] / 48 for o in mine]))
 
 
 def test_a_grid_that_misses_v_fra_is_extended_along_the_papers_speeds():

@@ -14,6 +14,11 @@ E_imp <= 1e-3, bonds at the JKR equilibrium delta_0, a gap of delta_c / 2, the s
               if built touching and never relaxed
   gap 1 um    the aggregates start 10 grain radii apart instead of delta_c / 2
 
+and the undamped frictional model at 63.1 m/s at base and dt 0.014 only: its v_fra rose
+from 54 m/s at N_tot 2000 (``bpca3d_models``, dt 0.014 t_c) to 82 at 10^4 (``vfra_size``,
+--dt auto), a change of size and of time step at once, and its near-head-on collisions
+turn as the frictionless ones do (63.1 m/s head-on: +0.53 at 2 x 1000, +0.8 at 2 x 5000);
+
 and, from the base runs' own settle checks, the end of the run: f_gro at the paper's
 snapshot times (0.4 ... 1.6 us) against the settle rule's end.
 
@@ -24,10 +29,14 @@ standard error over seeds; ``common.within_scatter``), never run against run. Th
 trend itself is read from the same offsets of ``validation/paper_protocol``'s records
 (2 x 5000 seeds 1, 2; 2 x 50000 seed 1).
 
-Writes RESULTS (default validation/size_trend/): runs.csv, summary.json, fig_size_trend.png
-and records/ (every run's small record).
+The dissipation that makes the difference is read from the records of the frictionless
+base runs and of the paper protocol's: E_dis(t) / E_imp against time in aggregate crossing
+times 2 r_c / v_col, and at the end, with N_con, N_cut and single grains ejected per grain.
 
-    ./run validate size_trend               # 4 arms x 4 offsets x 4 seeds at 2 x 1000
+Writes RESULTS (default validation/size_trend/): runs.csv, summary.json, fig_size_trend.png,
+fig_dissipation_size.png and records/<question>/<arm>/ (every run's small record).
+
+    ./run validate size_trend               # (4 + 2 arms) x 4 offsets x 4 seeds, 2 x 1000
     ./run validate size_trend --summary-only
     ./run validate size_trend --quick       # 2 x 24 grains (tests)
 """
@@ -44,19 +53,26 @@ from bpca3d_models import model_spec
 from common import (HERE, campaign_study_parser, mean_se, run_campaigns, save, study_paths,
                     within_scatter, write_summary)
 from jkrdt import rundir
-from jkrdt.analysis.tables import write_csv
+from jkrdt.analysis.tables import read_csv, write_csv
 from jkrdt.stopping import COMPLETE
 from paper_protocol import SNAPSHOTS_US, f_gro_at
 from vfra_size import TOLERANCE
 
-MODEL = "frictionless"
-FULL = dict(n=1000, v_col=39.8, b_off2=[0.0, 1 / 12, 2 / 12, 3 / 12], seeds=[1, 2, 3, 4])
-QUICK = dict(n=24, v_col=39.8, b_off2=[0.0, 1 / 12], seeds=[1, 2])
+FULL = dict(n=1000, b_off2=[0.0, 1 / 12, 2 / 12, 3 / 12], seeds=[1, 2, 3, 4])
+QUICK = dict(n=24, b_off2=[0.0, 1 / 12], seeds=[1, 2])
 #: the paper's eq. (1) weights of these offsets on its grid (trapezoid, B_off^2 = k/12)
 WEIGHT = {0: 0.5, 1: 1.0, 2: 1.0, 3: 1.0}
 AUTO = dict(dt="auto", tolerance=TOLERANCE)
 ARMS = {"base": AUTO, "dt 0.014": dict(dt=0.014), "touching": dict(AUTO, bond="touching"),
         "gap 1 um": dict(AUTO, gap=1.0e-6)}
+#: the models and speeds asked, each with the arms it runs: the frictionless head-on turn
+#: (all candidates), and the undamped frictional model near its v_fra, whose size trend
+#: (v_fra 54 m/s at N_tot 2000 with dt 0.014 t_c, 82 at 10^4 with --dt auto) crossed a
+#: change of the time step
+QUESTIONS = {"frictionless 39.8": dict(model="frictionless", v_col=39.8, arms=list(ARMS)),
+             "frictional 63.1": dict(model="frictional", v_col=63.1, arms=["base", "dt 0.014"])}
+#: the question whose base runs are read against the paper protocol's at larger sizes
+TREND = "frictionless 39.8"
 #: where the paper-size and 2 x 5000 runs of the same protocol keep their records
 PROTOCOL_RECORDS = HERE / "paper_protocol" / "records"
 
@@ -74,7 +90,7 @@ def f_near(by_offset: dict[int, float]) -> float:
 
 
 def load(records: Path) -> list[dict]:
-    """One row per finished run below ``records`` (arm = its campaign's folder)."""
+    """One row per finished run below ``records`` (RECORDS/<question>/<arm>/...)."""
     rows = []
     for path in sorted(records.rglob(rundir.OUTCOME)):
         o = json.loads(path.read_text())
@@ -82,7 +98,8 @@ def load(records: Path) -> list[dict]:
             continue
         meta = json.loads((path.parent / rundir.META).read_text())
         at = f_gro_at(path.parent, o["N_tar"], o["N_pro"])
-        rows.append(dict(arm=path.relative_to(records).parts[0], N_tar=o["N_tar"],
+        question, arm = path.relative_to(records).parts[:2]
+        rows.append(dict(question=question, arm=arm, N_tar=o["N_tar"],
                          b2_twelfths=twelfth(o["B_off"] ** 2), seed=o["seed"],
                          f_gro=o["growth_efficiency"], dt_over_tc=meta.get("dt_over_tc"),
                          time_end_over_tc=o.get("time_end_over_tc"),
@@ -134,51 +151,140 @@ def size_rows(records: Path) -> dict:
     return out
 
 
-def figure(summary: dict, results: Path) -> list[Path]:
+def dissipation_runs(records: Path, protocol_records: Path) -> list[dict]:
+    """Each base run here and each question-b run of the paper protocol at B_off^2 <= 3/12:
+    its size, offset, seed, f_gro, the energy dissipated (/ E_imp), N_con and N_cut per
+    grain, single grains ejected per grain, and its aggregates' r_c = sqrt(5/3) r_g (from
+    the first frame) with their filling factor N r_1^3 / r_c^3 and crossing time 2 r_c / v."""
+    paths = sorted((records / folder(TREND) / folder("base")).rglob(rundir.OUTCOME))
+    for k in WEIGHT:
+        paths += sorted(protocol_records.glob(f"n*_b_b2_{k / 12:.4f}/v39.8/*/seed*/"
+                                              f"{rundir.OUTCOME}"))
+    out = []
+    for path in paths:
+        o = json.loads(path.read_text())
+        if o.get("stop_reason") not in COMPLETE or twelfth(o["B_off"] ** 2) not in WEIGHT:
+            continue
+        frames = read_csv(path.parent / rundir.FRAMES)
+        r_c = np.sqrt(5 / 3) * frames[0]["gyration_radius_largest"]
+        n = o["n_total"]
+        out.append(dict(N_tar=o["N_tar"], b2_twelfths=twelfth(o["B_off"] ** 2), seed=o["seed"],
+                        f_gro=o["growth_efficiency"], E_dis=o["dissipated_fraction"],
+                        kinetic_left=o["kinetic_left"], N_con=o["N_con"] / n,
+                        N_cut=o["N_cut"] / n, singles=o["diagnostics"]["N_cum_1"] / n,
+                        r_c_over_r1=r_c / o["radius"],
+                        filling=o["N_tar"] * (o["radius"] / r_c) ** 3,
+                        t_cross=2 * r_c / o["v_col"],
+                        t=[f["time"] for f in frames], E_dis_t=[f["dissipated"] / o["E_imp"]
+                                                                 for f in frames]))
+    return out
+
+
+def dissipation_table(runs: list[dict]) -> dict:
+    """Per size and offset, the seeds' means of the final measures."""
+    table = {}
+    for n in sorted({r["N_tar"] for r in runs}):
+        for k in sorted(WEIGHT):
+            got = [r for r in runs if r["N_tar"] == n and r["b2_twelfths"] == k]
+            if got:
+                table.setdefault(str(n), {})[f"{k}/12"] = dict(
+                    seeds=len(got), **{m: float(np.mean([r[m] for r in got])) for m in (
+                        "f_gro", "E_dis", "kinetic_left", "N_con", "N_cut", "singles",
+                        "r_c_over_r1", "filling", "t_cross")})
+    return table
+
+
+def dissipation_figure(runs: list[dict], results: Path) -> list[Path]:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2))
-    arms = list(summary["arms"])
-    for i, name in enumerate(arms):
-        s = summary["arms"][name]
+    sizes = sorted({r["N_tar"] for r in runs})
+    colour = dict(zip(sizes, ["tab:blue", "tab:orange", "tab:red", "tab:green"]))
+    for r in runs:
+        if r["b2_twelfths"] in (0, 1):
+            a.plot(np.array(r["t"]) / r["t_cross"], r["E_dis_t"], color=colour[r["N_tar"]],
+                   ls="-" if r["b2_twelfths"] == 0 else "--", lw=1)
+    for n in sizes:
+        a.plot([], [], color=colour[n], label=f"2 x {n}")
+    a.plot([], [], "k-", label="head-on")
+    a.plot([], [], "k--", label="B_off^2 1/12")
+    a.set_xlabel("t / (2 r_c / v_col): aggregate crossing times")
+    a.set_ylabel("E_dis(t) / E_imp")
+    a.set_xlim(0, 8)
+    a.legend(fontsize=7)
+    a.set_title("energy dissipated, frictionless, undamped, 39.8 m/s")
+    for k, marker in zip(sorted(WEIGHT), "osD^"):
+        got = [r for r in runs if r["b2_twelfths"] == k]
+        x = [r["N_tar"] ** (-1 / 3) for r in got]
+        b.plot(x, [r["E_dis"] for r in got], marker, color="tab:red", alpha=0.7,
+               label=f"E_dis / E_imp, {k}/12")
+        b.plot(x, [r["f_gro"] for r in got], marker, color="tab:blue", mfc="none",
+               label=f"f_gro, {k}/12")
+    b.axhline(0, color="0.6", lw=0.8)
+    b.set_xlabel("N_tar^(-1/3) (surface share of an aggregate; 2 x 50000 at left)")
+    b.set_xlim(left=0)
+    b.legend(fontsize=6, ncol=2)
+    b.set_title("at the end of each run")
+    fig.tight_layout()
+    return save(fig, results, "fig_dissipation_size")
+
+
+def figure(summary: dict, results: Path) -> list[Path]:
+    """f_gro per offset of the trend's arms and of the larger sizes; every question's
+    candidates against its base as f_near with its standard error."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11.5, 4.4))
+    n = summary["plan"]["n"]
+    trend = summary["asked"][TREND]["arms"]
+    for i, (name, s) in enumerate(trend.items()):
         ks = [int(k.split("/")[0]) for k in s["per_offset"]]
         m = [v[0] for v in s["per_offset"].values()]
         e = [v[1] if np.isfinite(v[1]) else 0 for v in s["per_offset"].values()]
         a.errorbar(np.array(ks) + 0.06 * (i - 1.5), m, yerr=e, marker="o", capsize=3,
-                   label=f"2 x {summary['plan']['n']}: {name}")
-    for n, s in summary["sizes"].items():
+                   label=f"2 x {n}: {name}")
+    for size, s in summary["sizes"].items():
         ks = [int(k.split("/")[0]) for k in s["per_offset"]]
-        a.plot(ks, list(s["per_offset"].values()), "k--" if n == "5000" else "k-",
-               marker="s", label=f"2 x {n}: paper protocol, seeds {s['seeds']}")
+        a.plot(ks, list(s["per_offset"].values()), "k--" if size == "5000" else "k-",
+               marker="s", label=f"2 x {size}: paper protocol, seeds {s['seeds']}")
     a.axhline(0, color="0.6", lw=0.8)
     a.set_xlabel("B_off^2 (twelfths)")
     a.set_ylabel("f_gro")
-    a.set_title(f"frictionless, undamped, {summary['plan']['v_col']} m/s")
+    a.set_title(f"{TREND} m/s, undamped: f_gro by offset and size")
     a.legend(fontsize=7)
-    names = arms + [f"base at {t:g} us" for t in SNAPSHOTS_US]
-    vals = [summary["arms"][n]["f_near"] for n in arms] + \
-           [summary["end_of_run"][f"{t:g}"]["f_near"] for t in SNAPSHOTS_US]
+    names, vals = [], []
+    for q, asked in summary["asked"].items():
+        for name, s in asked["arms"].items():
+            names.append(f"{q}: {name}")
+            vals.append(s["f_near"])
+        if q == TREND:
+            for t in SNAPSHOTS_US:
+                names.append(f"{q}: base at {t:g} us")
+                vals.append(asked["end_of_run"][f"{t:g}"]["f_near"])
     y = np.arange(len(names))
     b.errorbar([v[0] for v in vals], y, xerr=[v[1] if np.isfinite(v[1]) else 0 for v in vals],
                fmt="o", capsize=3)
-    b.set_yticks(y, names)
-    b.axvline(summary["arms"]["base"]["f_near"][0], color="0.6", lw=0.8)
-    b.set_xlabel("f_near: f_gro over B_off^2 <= 3/12 (eq. 1 weights), mean +- se over seeds")
-    b.set_title(f"candidates at 2 x {summary['plan']['n']}, against base")
+    b.set_yticks(y, names, fontsize=7)
+    for q, asked in summary["asked"].items():
+        if "base" in asked["arms"]:
+            b.axvline(asked["arms"]["base"]["f_near"][0], color="0.6", lw=0.8)
+    b.set_xlabel("f_near (B_off^2 <= 3/12, eq. 1 weights): mean +- se over seeds")
+    b.set_title(f"each candidate against its base, 2 x {n}")
     fig.tight_layout()
     return save(fig, results, "fig_size_trend")
 
 
-def summarise(records: Path, results: Path, plot: bool = True) -> dict:
-    rows = load(records)
-    write_csv(results / "runs.csv", rows)
-    arms = {name: arm_summary([r for r in rows if r["arm"] == folder])
-            for name, folder in ARM_FOLDERS.items()
-            if any(r["arm"] == folder for r in rows)}
-    base_rows = [r for r in rows if r["arm"] == ARM_FOLDERS["base"]]
+def question_summary(rows: list[dict]) -> dict:
+    """One question's arms, base's f_near at the snapshot times, and each against base."""
+    arms = {name: arm_summary([r for r in rows if r["arm"] == folder(name)])
+            for name in ARMS if any(r["arm"] == folder(name) for r in rows)}
+    base_rows = [r for r in rows if r["arm"] == folder("base")]
     end = {f"{t:g}": arm_summary(base_rows, f"f_gro_at_{t:g}_us") for t in SNAPSHOTS_US}
     compared = {}
     if "base" in arms:
@@ -188,35 +294,52 @@ def summarise(records: Path, results: Path, plot: bool = True) -> dict:
             d, se, agree = within_scatter(tuple(arms["base"]["f_near"]), tuple(s["f_near"]))
             compared[name] = dict(difference=d, se=se, agree=agree,
                                   mean_f_gro_difference=d * 3.5 / 12)
-    summary = dict(plan=PLAN, arms_spec=ARMS, weights=WEIGHT, results=compared, arms=arms,
-                   end_of_run=end, sizes={str(n): v for n, v in size_rows(PROTOCOL_RECORDS
-                                                                           ).items()},
+    return dict(arms=arms, end_of_run=end, compared=compared)
+
+
+def summarise(records: Path, results: Path, plot: bool = True) -> dict:
+    rows = load(records)
+    write_csv(results / "runs.csv", rows)
+    asked = {q: question_summary([r for r in rows if r["question"] == folder(q)])
+             for q in QUESTIONS if any(r["question"] == folder(q) for r in rows)}
+    dissipation = dissipation_runs(records, PROTOCOL_RECORDS)
+    summary = dict(plan=PLAN, questions=QUESTIONS, arms_spec=ARMS, weights=WEIGHT,
+                   results={q: a["compared"] for q, a in asked.items()}, asked=asked,
+                   dissipation_by_size=dissipation_table(dissipation),
+                   sizes={str(n): v for n, v in size_rows(PROTOCOL_RECORDS).items()},
                    runs_finished=len(rows))
-    if plot and "base" in arms:
+    if plot and "base" in asked.get(TREND, {}).get("arms", {}):
         figure(summary, results)
+        dissipation_figure(dissipation, results)
     return summary
 
 
 PLAN = FULL
-ARM_FOLDERS = {name: name.replace(" ", "_") for name in ARMS}
+
+
+def folder(name: str) -> str:
+    """The folder of a question or an arm ("dt 0.014" -> dt_0.014)."""
+    return name.replace(" ", "_")
 
 
 def main(argv=None) -> int:
     global PLAN
     p = campaign_study_parser(__doc__)
-    p.add_argument("--arms", nargs="+", default=list(ARMS), choices=list(ARMS),
-                   help="run only these arms (default: all, base first)")
+    p.add_argument("--questions", nargs="+", default=list(QUESTIONS), choices=list(QUESTIONS),
+                   help="run only these (default: all, in this order)")
     p.add_argument("--summary-only", action="store_true",
                    help="only remake the results from the records kept")
     args = p.parse_args(argv)
     PLAN = QUICK if args.quick else FULL
     runs, results = study_paths(args, "size_trend")
     if not args.summary_only:
-        specs = {ARM_FOLDERS[name]: model_spec(MODEL, PLAN["n"], v_col=[PLAN["v_col"]],
-                                               b_off2=PLAN["b_off2"], seeds=PLAN["seeds"],
-                                               **ARMS[name])
-                 for name in args.arms}
-        run_campaigns(specs, runs, args.np)
+        for q in args.questions:
+            asked = QUESTIONS[q]
+            specs = {folder(arm): model_spec(asked["model"], PLAN["n"], v_col=[asked["v_col"]],
+                                             b_off2=PLAN["b_off2"], seeds=PLAN["seeds"],
+                                             **ARMS[arm])
+                     for arm in asked["arms"]}
+            run_campaigns(specs, runs / folder(q), args.np)
     return write_summary(results, summarise(results / "records", results))
 
 
