@@ -259,23 +259,24 @@ def figure(summary: dict, results: Path) -> list[Path]:
     a.set_title(f"{TREND} m/s, undamped: f_gro by offset and size")
     a.legend(fontsize=7)
     names, vals = [], []
-    for q, asked in summary["asked"].items():
-        for name, s in asked["arms"].items():
+    for q, compared in summary["results"].items():
+        for name, c in compared.items():
             names.append(f"{q}: {name}")
-            vals.append(s["f_near"])
-        if q == TREND:
-            for t in SNAPSHOTS_US:
-                names.append(f"{q}: base at {t:g} us")
-                vals.append(asked["end_of_run"][f"{t:g}"]["f_near"])
+            vals.append((c["difference"], c["se"]))
+    base = summary["asked"][TREND]["arms"].get("base")
+    for size, s in summary["sizes"].items():          # size itself, against the same base
+        if s["f_near"] is not None and base:
+            names.append(f"{TREND}: 2 x {size} (seeds {s['seeds']})")
+            vals.append((s["f_near"] - base["f_near"][0], base["f_near"][1]))
     y = np.arange(len(names))
-    b.errorbar([v[0] for v in vals], y, xerr=[v[1] if np.isfinite(v[1]) else 0 for v in vals],
-               fmt="o", capsize=3)
+    colours = ["k" if "2 x" in name else "tab:blue" for name in names]
+    for k in range(len(names)):
+        b.errorbar(vals[k][0], y[k], xerr=vals[k][1] if np.isfinite(vals[k][1]) else 0,
+                   fmt="o", capsize=3, color=colours[k])
     b.set_yticks(y, names, fontsize=7)
-    for q, asked in summary["asked"].items():
-        if "base" in asked["arms"]:
-            b.axvline(asked["arms"]["base"]["f_near"][0], color="0.6", lw=0.8)
-    b.set_xlabel("f_near (B_off^2 <= 3/12, eq. 1 weights): mean +- se over seeds")
-    b.set_title(f"each candidate against its base, 2 x {n}")
+    b.axvline(0, color="0.6", lw=0.8)
+    b.set_xlabel("f_near (B_off^2 <= 3/12, eq. 1 weights) minus base's, +- se")
+    b.set_title(f"candidates against base (2 x {n}); size in black")
     fig.tight_layout()
     return save(fig, results, "fig_size_trend")
 
