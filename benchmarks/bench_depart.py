@@ -54,8 +54,8 @@ def main(argv=None) -> None:
                             model=args.model, seed=args.seed)
     rundir.write(work / "scene", sc)
     variants = (dict(yes=dict(depart="yes"), no=dict(depart="no")) if not args.neighbor else
-                dict(yes=dict(depart="yes", neighbor="bin", sort="0 0.0"),
-                     no=dict(depart="yes", neighbor="nsq", sort="0 0.0")))
+                dict(yes=dict(depart="yes", neighbor="bin", sort="0"),
+                     no=dict(depart="yes", neighbor="nsq", sort="0")))
     # the run without departure (or with nsq) has the budget; the other runs to its end
     budget = dict(yes=float("inf"), no=args.budget)
     ran = alternate(work / "scene", variants, args.until_tc, budget, bounded_by="yes")

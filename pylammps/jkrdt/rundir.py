@@ -67,12 +67,12 @@ CLAIM = ".claim"
 SCENE_FILES = (DATA, META, DECK, *RUN_OUTPUTS, *ANALYSIS_OUTPUTS, *ROLLING_RESTARTS,
                FINAL_RESTART, FINAL_DUMP)
 
-#: up to this many grains a scene does not sort its atoms (``atom_modify sort 0``): the
-#: sort at a run's set-up reorders the atoms, and with them the order of the force sums,
-#: so that a run continued from a restart file would part from the uninterrupted one in
-#: the last bits; without it the two are equal bit for bit. At this size sorting gains
-#: nothing (2 x 1000: bins 2.1x faster than nsq either way); at 2 x 25000 it makes the
-#: loop 1.7-2x faster, so larger scenes sort and their continued runs agree as ensembles
+#: up to this many grains a scene does not sort its atoms (``atom_modify sort 0``): at this
+#: size sorting gains nothing (2 x 1000: bins 2.1x faster than nsq either way); at 2 x 25000
+#: it makes the loop 1.7-2x faster. Larger scenes sort at the restart steps (the deck's
+#: ``sort``, default ``every``): LAMMPS sorts at every run's set-up, and a continued run
+#: then starts from the order the uninterrupted one had just sorted into, so the force sums
+#: keep their order and the continuation is the same run bit for bit (issue 48)
 UNSORTED_MAX = 2000
 
 #: the deck's last line, printed after the last frames and final.restart
@@ -169,7 +169,7 @@ def deck_variables(scene: Scene) -> dict:
     """The variables of ``inputs/collision.lmp`` that make it run ``scene``."""
     few = scene.n_tar + scene.n_pro <= UNSORTED_MAX
     return dict(file=DATA, dim=scene.dim, coeffs=scene.pair_coeff, **time_variables(scene),
-                **(dict(sort="0 0.0") if few else {}))
+                **(dict(sort="0") if few else {}))
 
 
 def fixed_steps(steps: int, every: int) -> dict:
