@@ -28,7 +28,9 @@ using namespace LAMMPS_NS;
 FixJKRDTSettle::FixJKRDTSettle(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), window(5), tolerance(0.01), counts(1.0e-4), cap(-1.0), state(RUNNING),
     rerun(false), last_check(-1),
-    now{0, 0, 0, 0.0}, departure(lmp), table_append(false)
+    now{0, 0, 0, 0.0}, departure(lmp),
+    time_origin(update->atime + (update->ntimestep - update->atimestep) * update->dt),
+    dt_origin(update->dt), step_origin(update->ntimestep), table_append(false)
 {
   const char *usage = "fix ID all jkr/dt/settle N window K tolerance f [counts c] [cap T] "
                       "[depart yes|no|shadow] [table FILE] [append yes|no]";
@@ -200,6 +202,7 @@ void FixJKRDTSettle::write_check(Graph &graph)
 
 double FixJKRDTSettle::simulated_time() const
 {
+  if (update->dt == dt_origin) return time_origin + (update->ntimestep - step_origin) * dt_origin;
   return update->atime + (update->ntimestep - update->atimestep) * update->dt;
 }
 
@@ -284,12 +287,19 @@ double FixJKRDTSettle::compute_vector(int n)
 }
 
 /* ----------------------------------------------------------------------
-   restart: the last check and the window's partitions
+   restart: the last check and the window's partitions, after a header: a marker
+   (RESTART_WALL, not a whole number, where older files hold the last check's step),
+   the table's wall clock, so that a continued run's wall column goes on from it, and
+   the origin of the simulated time (time, step, dt)
 ------------------------------------------------------------------------- */
+
+static constexpr double RESTART_WALL = -2.5;    // never a step (older files: -1 or a step)
 
 void FixJKRDTSettle::write_restart(FILE *fp)
 {
-  std::vector<double> list = {static_cast<double>(last_check),
+  std::vector<double> list = {RESTART_WALL, table ? table->wall() : 0.0, time_origin,
+                              static_cast<double>(step_origin), dt_origin,
+                              static_cast<double>(last_check),
                               static_cast<double>(history.size())};
   for (const auto &h : history) {
     list.push_back(static_cast<double>(h.n_largest));
@@ -307,6 +317,13 @@ void FixJKRDTSettle::write_restart(FILE *fp)
 void FixJKRDTSettle::restart(char *buf)
 {
   auto *list = reinterpret_cast<double *>(buf);
+  if (list[0] == RESTART_WALL) {      // files of older builds start at the last check
+    if (table) table->continue_from(list[1]);
+    time_origin = list[2];
+    step_origin = static_cast<bigint>(list[3]);
+    dt_origin = list[4];
+    list += 5;
+  }
   last_check = static_cast<bigint>(list[0]);
   const int n = static_cast<int>(list[1]);
   history.clear();

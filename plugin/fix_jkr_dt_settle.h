@@ -103,6 +103,12 @@ class FixJKRDTSettle : public Fix {
   using Graph = FragmentGraph;    // the fragments (jkr_dt_fragments.h)
   Partition partition(Graph &graph) const;
   SettleDeparture departure;     // depart yes|no|shadow (fix_jkr_dt_settle_depart.*)
+  // the simulated time counts from an origin (time, step, dt) taken when the fix is defined
+  // and carried through restart files, so that a continued run's times are the
+  // uninterrupted run's to the bit (LAMMPS's own atime restarts from the file's step);
+  // LAMMPS's count where dt has changed since
+  double time_origin, dt_origin;
+  bigint step_origin;
   double simulated_time() const;
   std::string table_path;        // the in-run table; empty: none
   bool table_append;

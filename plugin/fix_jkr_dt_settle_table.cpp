@@ -15,7 +15,8 @@
      gyration_radius_largest    r_g of the largest fragment (equal grains), m
      N_cum_1, N_cum_4, N_cum_16 grains in fragments of at most 1, 4, 16 grains
      departed_grains, departed_fragments   what has departed so far
-     wall                       wall-clock seconds since the fix was defined
+     wall                       wall-clock seconds since the fix was defined, and in a
+                                run continued from a restart file, since the run began
      memory_mb, peak_rss_mb     the largest over the ranks of LAMMPS's own count
                                 of its memory and of the peak resident size, MB
 
@@ -61,6 +62,16 @@ SettleTable::SettleTable(LAMMPS *lmp, const std::string &path_, bool append) :
 SettleTable::~SettleTable()
 {
   if (file) fclose(file);
+}
+
+double SettleTable::wall() const
+{
+  return platform::walltime() - start;
+}
+
+void SettleTable::continue_from(double seconds)
+{
+  start = platform::walltime() - seconds;
 }
 
 void SettleTable::write(FragmentGraph &graph, const Check &check)
@@ -127,7 +138,7 @@ void SettleTable::write(FragmentGraph &graph, const Check &check)
              "{},{:.17g},{},{},{},{},{},{},{:.17g},{},{},{},{:.17g},{:.17g},{:.6g},{:.6g},{:.6g}\n",
              update->ntimestep, check.time, atom->natoms, first, second, check.n_fragments,
              check.contacts, inside, rg, singles, cum4, cum16, check.departed_grains,
-             check.departed_fragments, platform::walltime() - start, largest_memory[0],
+             check.departed_fragments, wall(), largest_memory[0],
              largest_memory[1]);
   fflush(file);
 }

@@ -26,11 +26,15 @@ class SettleTable : protected Pointers {
   SettleTable(class LAMMPS *lmp, const std::string &path, bool append);
   ~SettleTable() override;
   void write(FragmentGraph &graph, const Check &check);    // collective
+  // the wall column: seconds since the table was opened, plus what a run continued from
+  // a restart file had spent before it (continue_from), so it goes on, not back to 0
+  double wall() const;
+  void continue_from(double seconds);
 
  private:
   std::string path;
   FILE *file;
-  double start;    // wall-clock time the table was opened
+  double start;    // wall-clock time the table was opened, less the time continued from
 };
 
 }    // namespace LAMMPS_NS

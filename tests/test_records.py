@@ -82,6 +82,19 @@ def test_a_run_cut_off_continues_as_the_uninterrupted_one_and_a_finished_one_is_
         assert outcomes[1][key] == outcomes[0][key], key
     frames = [(d / "frames.csv").read_text().splitlines()[1:] for d in (straight, cut)]
     assert [r.split(",")[0] for r in frames[1]] == [r.split(",")[0] for r in frames[0]]
+    # the settle table: the same rows but for the timing columns (the later row of a step
+    # written twice is the one that counts), and its wall clock goes on across the
+    # continuation instead of starting again at 0
+    from jkrdt.analysis.tables import read_csv
+
+    timing = ("wall", "memory_mb", "peak_rss_mb")
+    tables = []
+    for d in (straight, cut):
+        rows = {r["step"]: r for r in read_csv(d / "checks.csv")}
+        tables.append([{k: v for k, v in r.items() if k not in timing} for r in rows.values()])
+    assert tables[1] == tables[0]
+    walls = [r["wall"] for r in read_csv(cut / "checks.csv")]
+    assert all(b >= a for a, b in zip(walls, walls[1:])), walls
     log = (cut / "log.lammps").read_text()
     assert log.count("Reading restart file") == 1 and log.count("Reading data file") == 1
     kept = (cut / "outcome.json").stat().st_mtime_ns
