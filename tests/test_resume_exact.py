@@ -62,3 +62,52 @@ def test_on_two_ranks_too(scene, tmp_path):
     straight = ends.pop("straight")
     for name, end in ends.items():
         assert np.array_equal(end, straight), (name, np.abs(end - straight).max())
+
+
+def test_a_campaign_killed_three_times_publishes_the_uninterrupted_numbers(tmp_path):
+    # 4 collisions of 2 x 2500 grains (two offsets x two seeds), each to a cap of 60 t_c
+    # with a check (and restart files) every 5 t_c, run once straight and once killed
+    # with SIGKILL at three moments (drawn from a fixed seed) and started again each time:
+    # every outcome.json and every checks.csv are the same but for where the run lies and
+    # the timing columns
+    import json
+    import os
+    import random
+    import signal
+    import time
+
+    from jkrdt.analysis.tables import read_csv
+    from jkrdt.campaign import run_campaign
+
+    spec = dict(kind="bpca", dim=3, n_tar=2500, n_pro=2500, material="ice",
+                model="frictionless", v_col=[39.8], b_off2=[0.0, 0.25], seeds=[1, 2],
+                settle=dict(check_tc=5, cap_tc=60))
+    path = tmp_path / "spec.json"
+    path.write_text(json.dumps(spec))
+    t0 = time.time()
+    run_campaign(path, tmp_path / "straight", progress=False)
+    whole = time.time() - t0
+    moments = random.Random(48)
+    for _ in range(3):
+        proc = subprocess.Popen([str(BIN / "jkrdt"), "campaign", str(path),
+                                 str(tmp_path / "killed"), "--quiet"], start_new_session=True)
+        time.sleep(moments.uniform(0.2, 0.9) * whole)
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+    assert run_campaign(path, tmp_path / "killed", progress=False)["runs"] == 4
+    continued = sum(p.read_text().count("Reading restart file")
+                    for p in (tmp_path / "killed").rglob("log.lammps"))
+    assert continued >= 1, "no kill fell inside a run"
+    timing = {"wall", "memory_mb", "peak_rss_mb"}
+    outcomes = sorted((tmp_path / "straight").rglob("outcome.json"))
+    assert len(outcomes) == 4
+    for straight in outcomes:
+        again = tmp_path / "killed" / straight.parent.relative_to(tmp_path / "straight")
+        a, b = (json.loads(p.read_text()) for p in (straight, again / "outcome.json"))
+        for o in (a, b):
+            o.pop("run"), o.pop("pictures", None)
+        assert a == b, straight.parent
+        rows = [[{k: v for k, v in r.items() if k not in timing}
+                 for r in {r["step"]: r for r in read_csv(d / "checks.csv")}.values()]
+                for d in (straight.parent, again)]
+        assert rows[0] == rows[1], straight.parent
