@@ -99,7 +99,8 @@ def main(argv=None) -> None:
         result["cost"] = dict(n_total=2 * args.n_cost, until_tc=args.until_tc,
                               load_average=ran["load_average"], summary=ran["summary"],
                               ratio_at_checks_over_1000=dict(
-                                  median=float(np.median(b / a)), mean_total=float(b.sum() / a.sum())),
+                                  median=float(np.median(b / a)),
+                                  mean_total=float(b.sum() / a.sum())),
                               series=ran["series"])
         print(json.dumps(result["cost"]["ratio_at_checks_over_1000"]), flush=True)
     result["cpu_count"] = os.cpu_count()

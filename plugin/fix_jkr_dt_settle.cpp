@@ -23,13 +23,19 @@
 
 using namespace LAMMPS_NS;
 
+// the simulated time as LAMMPS counts it (atime from the last change of dt or restart)
+static double lammps_time(const Update *update)
+{
+  return update->atime + (update->ntimestep - update->atimestep) * update->dt;
+}
+
 /* ---------------------------------------------------------------------- */
 
 FixJKRDTSettle::FixJKRDTSettle(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), window(5), tolerance(0.01), counts(1.0e-4), cap(-1.0), state(RUNNING),
     rerun(false), last_check(-1),
     now{0, 0, 0, 0.0}, departure(lmp),
-    time_origin(update->atime + (update->ntimestep - update->atimestep) * update->dt),
+    time_origin(lammps_time(update)),
     dt_origin(update->dt), step_origin(update->ntimestep), table_append(false)
 {
   const char *usage = "fix ID all jkr/dt/settle N window K tolerance f [counts c] [cap T] "
@@ -202,8 +208,8 @@ void FixJKRDTSettle::write_check(Graph &graph)
 
 double FixJKRDTSettle::simulated_time() const
 {
-  if (update->dt == dt_origin) return time_origin + (update->ntimestep - step_origin) * dt_origin;
-  return update->atime + (update->ntimestep - update->atimestep) * update->dt;
+  if (update->dt != dt_origin) return lammps_time(update);
+  return time_origin + (update->ntimestep - step_origin) * dt_origin;
 }
 
 /* ---------------------------------------------------------------------- */

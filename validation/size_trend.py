@@ -70,7 +70,8 @@ ARMS = {"base": AUTO, "dt 0.014": dict(dt=0.014), "touching": dict(AUTO, bond="t
 #: (v_fra 54 m/s at N_tot 2000 with dt 0.014 t_c, 82 at 10^4 with --dt auto) crossed a
 #: change of the time step
 QUESTIONS = {"frictionless 39.8": dict(model="frictionless", v_col=39.8, arms=list(ARMS)),
-             "frictional 63.1": dict(model="frictional", v_col=63.1, arms=["base", "dt 0.014"])}
+             "frictional 63.1": dict(model="frictional", v_col=63.1,
+                                     arms=["base", "dt 0.014"])}
 #: the question whose base runs are read against the paper protocol's at larger sizes
 TREND = "frictionless 39.8"
 #: where the paper-size and 2 x 5000 runs of the same protocol keep their records
@@ -82,7 +83,8 @@ def twelfth(b2: float) -> int:
 
 
 def f_near(by_offset: dict[int, float]) -> float:
-    """f_gro over B_off^2 <= 3/12 with the paper's grid weights (NaN if an offset is missing)."""
+    """f_gro averaged over the offsets given (B_off^2 <= 3/12, twelfths) with the paper's
+    grid weights; NaN if one lies outside them."""
     ks = [k for k in WEIGHT if k in by_offset]
     if len(ks) < len(by_offset) or not ks:
         return float("nan")
@@ -130,24 +132,18 @@ def arm_summary(rows: list[dict], key: str = "f_gro") -> dict:
                 share_of_mean_f_gro=mean * 3.5 / 12)
 
 
-def size_rows(records: Path) -> dict:
-    """f_near of the paper-protocol question b (39.8 m/s, frictionless) per size."""
+def size_rows(runs: list[dict]) -> dict:
+    """f_near of the paper-protocol question b (39.8 m/s, frictionless) per size, from its
+    runs among ``dissipation_runs``."""
     out = {}
-    if not records.exists():
-        return out
-    for n in (5000, 50000):
-        rows = []
-        for k in WEIGHT:
-            for path in records.glob(f"n{n}_b_b2_{k / 12:.4f}/v39.8/*/seed*/{rundir.OUTCOME}"):
-                o = json.loads(path.read_text())
-                rows.append(dict(b2_twelfths=k, seed=o["seed"], f_gro=o["growth_efficiency"]))
-        if rows:
-            offsets = {r["b2_twelfths"] for r in rows}
-            by_offset = {k: float(np.mean([r["f_gro"] for r in rows if r["b2_twelfths"] == k]))
-                         for k in sorted(offsets)}
-            out[n] = dict(per_offset={f"{k}/12": v for k, v in by_offset.items()},
-                          f_near=f_near(by_offset) if offsets == set(WEIGHT) else None,
-                          seeds=sorted({r["seed"] for r in rows}))
+    for n in sorted({r["N_tar"] for r in runs if r["source"] == "paper_protocol"}):
+        rows = [r for r in runs if r["source"] == "paper_protocol" and r["N_tar"] == n]
+        offsets = {r["b2_twelfths"] for r in rows}
+        by_offset = {k: float(np.mean([r["f_gro"] for r in rows if r["b2_twelfths"] == k]))
+                     for k in sorted(offsets)}
+        out[n] = dict(per_offset={f"{k}/12": v for k, v in by_offset.items()},
+                      f_near=f_near(by_offset) if offsets == set(WEIGHT) else None,
+                      seeds=sorted({r["seed"] for r in rows}))
     return out
 
 
@@ -156,19 +152,20 @@ def dissipation_runs(records: Path, protocol_records: Path) -> list[dict]:
     its size, offset, seed, f_gro, the energy dissipated (/ E_imp), N_con and N_cut per
     grain, single grains ejected per grain, and its aggregates' r_c = sqrt(5/3) r_g (from
     the first frame) with their filling factor N r_1^3 / r_c^3 and crossing time 2 r_c / v."""
-    paths = sorted((records / folder(TREND) / folder("base")).rglob(rundir.OUTCOME))
+    paths = [("size_trend", p) for p in sorted((records / folder(TREND) / folder("base"))
+                                               .rglob(rundir.OUTCOME))]
     for k in WEIGHT:
-        paths += sorted(protocol_records.glob(f"n*_b_b2_{k / 12:.4f}/v39.8/*/seed*/"
-                                              f"{rundir.OUTCOME}"))
+        paths += [("paper_protocol", p) for p in sorted(protocol_records.glob(
+            f"n*_b_b2_{k / 12:.4f}/v39.8/*/seed*/{rundir.OUTCOME}"))]
     out = []
-    for path in paths:
+    for source, path in paths:
         o = json.loads(path.read_text())
         if o.get("stop_reason") not in COMPLETE or twelfth(o["B_off"] ** 2) not in WEIGHT:
             continue
         frames = read_csv(path.parent / rundir.FRAMES)
         r_c = np.sqrt(5 / 3) * frames[0]["gyration_radius_largest"]
         n = o["n_total"]
-        out.append(dict(N_tar=o["N_tar"], b2_twelfths=twelfth(o["B_off"] ** 2), seed=o["seed"],
+        out.append(dict(source=source, N_tar=o["N_tar"], b2_twelfths=twelfth(o["B_off"] ** 2), seed=o["seed"],
                         f_gro=o["growth_efficiency"], E_dis=o["dissipated_fraction"],
                         kinetic_left=o["kinetic_left"], N_con=o["N_con"] / n,
                         N_cut=o["N_cut"] / n, singles=o["diagnostics"]["N_cum_1"] / n,
@@ -307,7 +304,7 @@ def summarise(records: Path, results: Path, plot: bool = True) -> dict:
     summary = dict(plan=PLAN, questions=QUESTIONS, arms_spec=ARMS, weights=WEIGHT,
                    results={q: a["compared"] for q, a in asked.items()}, asked=asked,
                    dissipation_by_size=dissipation_table(dissipation),
-                   sizes={str(n): v for n, v in size_rows(PROTOCOL_RECORDS).items()},
+                   sizes={str(n): v for n, v in size_rows(dissipation).items()},
                    runs_finished=len(rows))
     if plot and "base" in asked.get(TREND, {}).get("arms", {}):
         figure(summary, results)

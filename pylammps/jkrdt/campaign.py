@@ -14,8 +14,8 @@ are the 3D BPCA paper's grids (``jkrdt.protocol``: 10^(0.1 i) m/s for i = 10 ...
 B_off^2 = k/12 for k = 0 ... 11, the grazing 12/12 taken as no collision); the other keys default to the values above
 (material_overrides {}, settle {} = the settle rule's defaults), and any Material field
 can be overridden in material_overrides. "bond" and "gap" are the set-up's choices of
-``jkrdt.scene.Scene`` (null: bonds at delta_0, a gap of delta_c / 2). "dt" is in units of t_c, or "auto": each speed's
-dt then comes from "tolerance" (max |dE| / E_imp, default 1e-4) as ``jkrdt setup --dt auto
+``jkrdt.scene.Scene`` (null: bonds at delta_0, a gap of delta_c / 2). "dt" is in units of
+t_c, or "auto": each speed's dt then comes from "tolerance" (max |dE| / E_imp, default 1e-4) as ``jkrdt setup --dt auto
 --tolerance`` chooses it (``jkrdt.timestep``).
 
 Each run ends when its collision has settled (``jkrdt.stopping``; "settle" may be

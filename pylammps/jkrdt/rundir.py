@@ -59,7 +59,8 @@ ANALYSIS_OUTPUTS = (FRAMES, OUTCOME, "outcome.png", "outcome.pdf", "energy.png",
                     "energy.pdf", "timeline.png", "timeline.pdf")
 #: a finished run's small record, what a study commits of each run (under 1 MB at 2 x 5000):
 #: its scene's metadata, the settle rule's table, the timeline with the energy ledger and
-#: N_con, N_cut at every check, the outcome and its two pictures; the re-analysis of a study needs nothing else
+#: N_con, N_cut at every check, the outcome and its two pictures; the re-analysis of a
+#: study needs nothing else
 RECORD = (META, CHECKS, FRAMES, OUTCOME, "outcome.png", "timeline.png")
 #: a campaign's lock on a run (``claim``)
 CLAIM = ".claim"

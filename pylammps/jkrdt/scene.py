@@ -5,9 +5,9 @@ Wada et al. 2007 with the material's xi_crit; 'frictionless': the 3D BPCA paper'
 model without sliding, rolling and twisting), the aggregates' kind and sizes, v_col,
 B_off, the seed, the time step and the neighbor skin, and two choices of the set-up that
 the papers leave open (``bond``: the aggregates' bonds at the JKR equilibrium delta_0, as
-built by default, or touching; ``gap``: how far apart the aggregates start). It is a value: how it is written
-into a directory, read back and run (``collision.json``, the deck and its variables) is
-``jkrdt.rundir``'s.
+built by default, or touching; ``gap``: how far apart the aggregates start). It is a
+value: how it is written into a directory, read back and run (``collision.json``, the
+deck and its variables) is ``jkrdt.rundir``'s.
 
 E_imp = mu v_col^2 / 2 with mu = m N_tar N_pro / (N_tar + N_pro), equal grains of mass m.
 """
@@ -80,7 +80,7 @@ class Scene:
     dt_reason: str | None = None
     skin: float | None = None       # m; None: from the speed and dt (skin_for)
     bond: str = "equilibrium"       # one of BONDS
-    gap: float | None = None        # m between the nearest grains at the start; None: delta_c/2
+    gap: float | None = None        # m between the nearest grains at start; None: delta_c/2
 
     def __post_init__(self):
         if not self.v_col > 0:
