@@ -10,6 +10,10 @@
 #include "memory.h"
 #include "neigh_list.h"
 #include "neighbor.h"
+#include "output.h"
+#include "update.h"
+
+#include "jkr_dt_order.h"
 
 #include <algorithm>
 #include <limits>
@@ -241,6 +245,14 @@ int FixJKRDTContacts::setmask()
 void FixJKRDTContacts::pre_exchange()
 {
   to_rows();
+  // at a run's set-up and at each restart step (LAMMPS reneighbors there): the atoms on
+  // their ranks and in ID order, as a run continued from this step's restart file will
+  // have them (jkr_dt_order.h)
+  const bool restart_step = output->restart_flag && update->ntimestep == output->next_restart;
+  if (update->setupflag || restart_step) {
+    JKRDT::migrate_now(lmp);
+    JKRDT::order_by_id(lmp);
+  }
   if (writer.by) writer.on_exchange();
 }
 

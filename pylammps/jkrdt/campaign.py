@@ -274,7 +274,14 @@ def scene_of(spec: dict, v: float, b2: float, seed: int) -> Scene:
     return scene.with_dt_for(spec["tolerance"]) if auto else scene
 
 
-def prepare(directory: Path, scene: Scene, aggregates: dict):
+def last_step(spec: dict, scene: Scene) -> int:
+    """The step a run of ``spec`` ends at the latest: its cap, or its fixed steps."""
+    if spec["settle"] is None:
+        return spec["steps"]
+    return spec["settle"].cap_steps(scene.time_step()[0])
+
+
+def prepare(directory: Path, spec: dict, scene: Scene, aggregates: dict):
     """Make ``directory`` ready to run (on the group's leader): "ended" if its run ended
     and only its analysis is missing; (restart file, step) to resume from, the outputs
     cut back to that step; or None after writing the scene afresh."""
@@ -283,7 +290,8 @@ def prepare(directory: Path, scene: Scene, aggregates: dict):
         status = rundir.run_status(directory)
         if status.problem is None and status.stop_reason != "error":
             return "ended"
-    point = rundir.resume_point(directory)
+    point = rundir.resume_point(directory, last_step(spec, rundir.read(directory))) \
+        if (directory / rundir.META).exists() else None
     if point is not None:
         rundir.cut_back(directory, point[1])
         return point
@@ -302,8 +310,7 @@ def run_one(spec: dict, directory: Path, resume, comm) -> str | None:
     restart, start = resume if resume is not None else (None, 0)
     remaining = None
     if resume is not None and spec["settle"] is not None:      # the uninterrupted run's cap
-        ratio = rundir.read(directory).time_step()[0]
-        remaining = dict(steps=spec["settle"].cap_steps(ratio) - start)
+        remaining = dict(steps=last_step(spec, rundir.read(directory)) - start)
     try:
         with Session(directory, directory, every=spec["every"] or 1, comm=comm,
                      settle=spec["settle"], restart=restart, append=resume is not None,
@@ -373,7 +380,7 @@ def run_campaign(spec_path, campaign, progress: bool = True, ranks_per_run: int 
         if not group.bcast(held is not None):
             continue
         t0 = time.time()
-        resume = prepare(directory, scene_of(spec, v, b2, seed), aggregates) if leader \
+        resume = prepare(directory, spec, scene_of(spec, v, b2, seed), aggregates) if leader \
             else None
         resume = group.bcast(resume)
         failed = None if resume == "ended" else run_one(spec, directory, resume, group)

@@ -387,9 +387,13 @@ def claim(directory):
     return f
 
 
-def resume_point(directory):
+def resume_point(directory, end_step: int | None = None):
     """(restart file, its step) to continue a cut-off run from, or None: the newer restart
-    file that LAMMPS reads whole (a file cut off while being written is passed over)."""
+    file that LAMMPS reads whole (a file cut off while being written is passed over). One
+    written where the run ended (``end_step``, its cap, or the step the settle rule
+    stopped it at, as the log says: a run killed while it wrote its end) is passed over
+    for the one before, so the continuation runs the last check interval again and ends
+    where the uninterrupted run ended, with the same lines and files."""
     from mpi4py import MPI
 
     from .instance import start_lammps
@@ -397,6 +401,12 @@ def resume_point(directory):
     directory = Path(directory)
     if not (directory / META).exists():
         return None
+    if (directory / LOG).exists():
+        stops = [int(_settle_fields(line).get("step", -1)) for line in
+                 (directory / LOG).read_text(errors="replace").splitlines()
+                 if line.startswith(SETTLE_LINE)]
+        if stops and stops[-1] >= 0:
+            end_step = stops[-1] if end_step is None else min(end_step, stops[-1])
     rolling = (directory / name for name in ROLLING_RESTARTS)
     found = sorted((p for p in rolling if p.exists()), key=lambda p: p.stat().st_mtime,
                    reverse=True)
@@ -404,11 +414,13 @@ def resume_point(directory):
         lmp = start_lammps(MPI.COMM_SELF)
         try:
             lmp.command(f"read_restart {path}")
-            return path, int(lmp.extract_global("ntimestep"))
+            step = int(lmp.extract_global("ntimestep"))
         except Exception:
             continue
         finally:
             lmp.close()
+        if end_step is None or step < end_step:
+            return path, step
     return None
 
 
