@@ -14,7 +14,7 @@ from jkrdt.progress import complete_rows
 BIN = Path(sys.executable).parent
 JKRDT = str(BIN / "jkrdt")
 LINE = re.compile(r"^step (\d+)  t (\d+) t_c  N_lar (\d+)  fragments (\d+)  contacts (\d+)"
-                  r"  \|dE\|/E_imp (\S+)  (\S+) s/check(  cap in .* at most)?$")
+                  r"  \|dE\|/E_imp (\S+)(  (\S+) s/check)?(  cap in .* at most)?$")
 
 
 def test_jkrdt_run_shows_each_check_as_its_table_holds_it(tmp_path):

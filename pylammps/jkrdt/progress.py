@@ -11,7 +11,6 @@ under Slurm they are plain lines, flushed as they come."""
 from __future__ import annotations
 
 import sys
-import time
 from pathlib import Path
 
 from . import ledger, rundir
@@ -37,8 +36,7 @@ class CheckLines:
         self.cap_step, self.start_step = cap_step, start_step
         self.stream = stream or sys.stdout
         self.seen = start_step if start_step > 0 else -1    # a new run shows its step 0
-        self.last_wall = time.time()
-        self.started = self.last_wall
+        self.first_step, self.first_wall = None, 0.0
         use_bar = self.stream.isatty() if bar is None else bar
         self.bar = None
         if use_bar and cap_step:
@@ -54,7 +52,7 @@ class CheckLines:
         except (OSError, KeyError, ValueError, IndexError):
             return None
 
-    def line(self, row: dict, wall: float) -> str:
+    def line(self, row: dict, wall: float | None) -> str:
         step = int(row["step"])
         words = [f"step {step}", f"t {row['time'] / self.t_c:.0f} t_c",
                  f"N_lar {int(row['n_largest'])}", f"fragments {int(row['n_fragments'])}",
@@ -62,19 +60,27 @@ class CheckLines:
         error = self.energy_error()
         if error is not None:
             words.append(f"|dE|/E_imp {error:.1e}")
-        words.append(f"{wall:.1f} s/check")
-        if self.cap_step and step > self.start_step:
-            rate = (time.time() - self.started) / (step - self.start_step)
+        if wall is not None:
+            words.append(f"{wall:.1f} s/check")
+        if self.cap_step and step > self.first_step and "wall" in row:
+            rate = (row["wall"] - self.first_wall) / (step - self.first_step)
             left = (self.cap_step - step) * rate
             words.append(f"cap in {format_seconds(left)} at most")
         return "  ".join(words)
 
     def poll(self) -> None:
-        """Print the checks that have appeared since the last poll."""
-        rows = [r for r in complete_rows(self.out / rundir.CHECKS) if r["step"] > self.seen]
-        now = time.time()
-        for k, row in enumerate(rows):
-            wall = (now - self.last_wall) / len(rows)
+        """Print the checks that have appeared since the last poll. The wall times are the
+        table's own (its ``wall`` column, the run's seconds at each check)."""
+        table = complete_rows(self.out / rundir.CHECKS)
+        rows = [r for r in table if r["step"] > self.seen]
+        for row in rows:
+            if self.first_step is None:
+                self.first_step, self.first_wall = int(row["step"]), row.get("wall", 0.0)
+            before = [r for r in table if r["step"] < row["step"]]
+            wall = row["wall"] - before[-1]["wall"] if before and "wall" in row else None
+            if wall is not None and wall < 0:      # a table of an older build: its clock
+                wall = None                        # started again at a resume
+                self.first_step, self.first_wall = int(row["step"]), row["wall"]
             text = self.line(row, wall)
             if self.bar is not None:
                 self.bar.write(text)
@@ -82,8 +88,6 @@ class CheckLines:
             else:
                 print(text, file=self.stream, flush=True)
             self.seen = int(row["step"])
-        if rows:
-            self.last_wall = now
 
     def close(self) -> None:
         self.poll()
