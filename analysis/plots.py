@@ -284,10 +284,40 @@ def _by_speed(rows: list[dict]):
         yield v, [r for r in rows if r["v_col"] == v], f"C{k % 10}"
 
 
-def _label_b_off(ax, x, y, rows):
-    for xi, yi, r in zip(x, y, rows):
-        ax.annotate(f"{r['B_off']:.2g}", (xi, yi), textcoords="offset points", xytext=(3, 3),
-                    fontsize=6, color="0.3")
+def _by_offset(ax, x, y, rows, marker):
+    """The runs of one speed (one x: E_imp does not depend on B_off) spread a little
+    along x in order of B_off^2 and coloured by it, so that 4 or 12 offsets stay apart;
+    returns the colour scale for a colour bar."""
+    b2 = np.array([r["B_off"] ** 2 for r in rows], dtype=float)
+    rank = np.searchsorted(np.unique(b2), b2)
+    # within +-7 % of the speed's value, well inside the 58 % step of the paper's speed grid
+    spread = np.exp(0.14 * (rank / max(rank.max(), 1) - 0.5)) if len(rank) else rank
+    return ax.scatter(np.asarray(x, dtype=float) * spread, y, c=b2, cmap="viridis", vmin=0.0,
+                      vmax=1.0, marker=marker, s=28, edgecolors="0.2", linewidths=0.4)
+
+
+def _speed_ticks(ax, x):
+    """Ticks on a log axis at each speed's value only (its offsets spread about it)."""
+    from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator
+
+    values = sorted({float(v) for v in x})
+    if not values:
+        return
+    ax.xaxis.set_major_locator(FixedLocator(values))
+    ax.set_xticklabels([f"{v:.3g}" for v in values])
+    ax.xaxis.set_minor_locator(NullLocator())
+    ax.xaxis.set_minor_formatter(NullFormatter())
+    ax.set_xlim(values[0] / 1.25, values[-1] * 1.25)
+
+
+#: a marker per speed, slowest first
+SPEED_MARKERS = "osD^v<>pXh"
+
+
+def _offset_colour_bar(fig, ax, mappable):
+    bar = fig.colorbar(mappable, ax=ax, pad=0.01)
+    bar.set_label("B_off^2")
+    bar.set_ticks([k / 12 for k in range(0, 13, 3)], labels=["0", "3/12", "6/12", "9/12", "1"])
 
 
 def compression(path, rows: list[dict]):
@@ -296,16 +326,28 @@ def compression(path, rows: list[dict]):
     plt = _pyplot()
     fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4.5), constrained_layout=True)
     x_all = np.array([r["E_imp_over_nk_Eroll"] for r in rows], dtype=float)
-    for v, mine, colour in _by_speed(rows):
+    shown = None
+    for k, (v, mine, _) in enumerate(_by_speed(rows)):
+        marker = SPEED_MARKERS[k % len(SPEED_MARKERS)]
         x = np.array([r["E_imp_over_nk_Eroll"] for r in mine], dtype=float)
         rg = np.array([r["gyration_radius_largest"] / (r["radius"] * np.sqrt(r["n_largest"]))
                        for r in mine])
         ncon = np.array([r["contacts_per_particle"] for r in mine])
-        a.loglog(x, rg, "o", color=colour, label=f"v = {v:g} m/s")
-        b.loglog(x, np.where(ncon > 1, ncon - 1, np.nan), "o", color=colour,
-                 label=f"v = {v:g} m/s")
-        _label_b_off(a, x, rg, mine)
-        _label_b_off(b, x, ncon - 1, mine)
+        shown = _by_offset(a, x, rg, mine, marker)
+        _by_offset(b, x, np.where(ncon > 1, ncon - 1, np.nan), mine, marker)
+        for ax in (a, b):
+            ax.scatter([], [], marker=marker, c="0.5", label=f"v = {v:g} m/s")
+    for ax in (a, b):
+        ax.set_xscale("log")
+        y = np.concatenate([np.asarray(c.get_offsets())[:, 1] for c in ax.collections
+                            if len(c.get_offsets())] or [np.array([])])
+        if np.any(np.isfinite(y) & (y > 0)):       # n_con - 1 may be 0 for every run
+            ax.set_yscale("log")
+        _speed_ticks(ax, x_all)
+    if shown is not None:
+        _offset_colour_bar(fig, b, shown)
+    fig.suptitle("one point per run; a speed's offsets spread about it, coloured by B_off^2",
+                 fontsize=9)
     if _two_d_bcca(rows):
         e = np.logspace(np.log10(max(x_all.min(), 1e-3)) - 0.5, np.log10(x_all.max()) + 0.5, 50)
         a.loglog(e, 0.84 * e ** -0.12, "0.6", label="eq. (51), 2D BCCA")
@@ -313,26 +355,48 @@ def compression(path, rows: list[dict]):
     a.set_ylabel("r_g / (r_1 N_lar^1/2)")
     b.set_ylabel("n_con - 1")
     for ax in (a, b):
-        ax.set_xlabel("E_imp / (n_k E_roll)   (labels: B_off)")
+        ax.set_xlabel("E_imp / (n_k E_roll)")
         ax.legend(fontsize=8)
     return _save(fig, path)
 
 
 def disruption(path, rows: list[dict]):
-    """N_lar / N_total against E_imp / (n_k E_break), coloured by v_col and labelled with
-    B_off; for 2D BCCAs the marks of Wada et al. (2007) at 3 and 10 n_k E_break."""
+    """Left: N_lar / N_total against E_imp / (n_k E_break), a marker per v_col, coloured by
+    B_off^2; for 2D BCCAs the marks of Wada et al. (2007) at 3 and 10 n_k E_break. Right:
+    f_gro against B_off^2, a line per v_col (seeds averaged: the 3D paper's Fig. B.1)."""
     plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(6.5, 4.5), constrained_layout=True)
-    for v, mine, colour in _by_speed(rows):
+    fig, (ax, right) = plt.subplots(1, 2, figsize=(11, 4.5), constrained_layout=True,
+                                    gridspec_kw=dict(width_ratios=[1.15, 1]))
+    for k, (v, mine, colour) in enumerate(_by_speed(rows)):
+        b2 = np.array([r["B_off"] ** 2 for r in mine])
+        f = np.array([r["growth_efficiency"] for r in mine])
+        grid = np.unique(np.round(b2, 9))
+        mean = [f[np.isclose(b2, g)].mean() for g in grid]
+        right.plot(grid, mean, "-", color=colour, marker=SPEED_MARKERS[k % len(SPEED_MARKERS)],
+                   ms=4, label=f"v = {v:g} m/s")
+        right.plot(b2, f, ".", color=colour, alpha=0.35, ms=3)
+    right.axhline(0, color="0.6", lw=0.8)
+    right.set_xlim(0, 1)
+    right.set_xticks([k / 12 for k in range(0, 13, 3)], labels=["0", "3/12", "6/12", "9/12", "1"])
+    right.set_xlabel("B_off^2   (dots: each seed)")
+    right.set_ylabel("f_gro = (N_lar - N_tar) / N_pro")
+    right.legend(fontsize=8)
+    shown = None
+    for k, (v, mine, _) in enumerate(_by_speed(rows)):
         x = [r["E_imp_over_nk_Ebreak"] for r in mine]
         y = [r["n_largest"] / r["n_total"] for r in mine]
-        ax.semilogx(x, y, "o", color=colour, label=f"v = {v:g} m/s")
-        _label_b_off(ax, x, y, mine)
+        shown = _by_offset(ax, x, y, mine, SPEED_MARKERS[k % len(SPEED_MARKERS)])
+        ax.scatter([], [], marker=SPEED_MARKERS[k % len(SPEED_MARKERS)], c="0.5",
+                   label=f"v = {v:g} m/s")
+    ax.set_xscale("log")
+    _speed_ticks(ax, [r["E_imp_over_nk_Ebreak"] for r in rows])
+    if shown is not None:
+        _offset_colour_bar(fig, ax, shown)
     if _two_d_bcca(rows):
         for mark, text in [(3, "loss of one grain"), (10, "catastrophic")]:
             ax.axvline(mark, color="0.6", ls=":")
             ax.text(mark, 0.02, text + " (2D BCCA)", rotation=90, fontsize=8)
-    ax.set_xlabel("E_imp / (n_k E_break)   (labels: B_off)")
+    ax.set_xlabel("E_imp / (n_k E_break)   (a speed's offsets spread about it)")
     ax.set_ylabel("N_lar / N_total")
     ax.set_ylim(0, 1.05)
     ax.legend(fontsize=8)

@@ -35,7 +35,7 @@ N_CUM_AT = (1, 10, 100, 1000)
 DIAGNOSTICS = ["N_con", "N_cut", "E_dis_tot", "E_dis_c", "E_dis_v", "E_dis_sliding",
                "E_dis_rolling", "E_dis_twisting", *(f"N_cum_{n}" for n in N_CUM_AT)]
 SCALARS = ["model", "material", "xi_crit", "tvis", "kind", "dimension", "N_tar", "N_pro",
-           "v_col", "B_off", "seed", "radius", "E_imp", "n_k", "E_imp_over_nk_Eroll",
+           "v_col", "B_off", "B_off2", "seed", "radius", "E_imp", "n_k", "E_imp_over_nk_Eroll",
            "E_imp_over_nk_Ebreak", "step", "n_total", "n_largest", "n_second", "n_fragments",
            "growth_efficiency", "gyration_radius_largest", "contacts_per_particle",
            "dissipated_fraction", "energy_error", "energy_warning", "stop_reason", "stop_step",
@@ -109,6 +109,19 @@ def offset_table(groups) -> dict:
     return {name: dict(sorted(rows.items())) for name, rows in table.items()}
 
 
+def offset_rows(table: dict) -> list[dict]:
+    """``offset_table`` as rows of f_gro_by_offset.csv: model, B_off^2 (and as k/12),
+    then f_gro at each v_col (m/s)."""
+    rows = []
+    for name, by_b2 in table.items():
+        speeds = sorted({v for row in by_b2.values() for v in row}, key=float)
+        for b, row in by_b2.items():
+            rows.append(dict(model=name, B_off2=float(b),
+                             B_off2_twelfths=protocol.twelfths(float(b), 1e-3) or "",
+                             **{f"f_gro_{v}": row.get(v) for v in speeds}))
+    return rows
+
+
 def offset_table_text(table: dict) -> str:
     """``offset_table`` as the text ``jkrdt summarise`` prints: B_off^2 as k/12 where it
     is one, a column per v_col."""
@@ -118,7 +131,7 @@ def offset_table_text(table: dict) -> str:
         lines.append(f"f_gro by B_off^2 and v_col (m/s), {name} (the paper's Fig. B.1):")
         lines.append("B_off^2 " + "".join(f"{v:>8}" for v in speeds))
         for b, row in rows.items():
-            lines.append(f"{protocol.twelfths(float(b)) or b:<8}" + "".join(
+            lines.append(f"{protocol.twelfths(float(b), 1e-3) or b:<8}" + "".join(
                 f"{row[v]:+8.3f}" if v in row else f"{'':>8}" for v in speeds))
     return "\n".join(lines)
 
@@ -177,7 +190,7 @@ def mean_diagnostics(runs) -> dict[str, float | None]:
 
 def scalars(out: dict) -> dict:
     """One run's row of runs.csv: the outcome's ``SCALARS``, its diagnostics among them."""
-    row = dict(out, **diagnostics(out))
+    row = dict(out, **diagnostics(out), B_off2=round(out["B_off"] ** 2, 12))
     return {k: row.get(k, "steps" if k == "stop_reason" else None) for k in SCALARS}
 
 
@@ -258,9 +271,11 @@ def summarise(campaign, plot: bool = True, include_cap: bool = False) -> dict:
     seed_thresholds = {name: {k: threshold_velocity(v, f) for k, (v, f) in seeds.items()}
                        for name, seeds in per_seed.items()}
     write_csv(campaign / "summary.csv", table)
+    by_offset = offset_table(groups)
+    write_csv(campaign / "f_gro_by_offset.csv", offset_rows(by_offset))
     summary = dict(runs=len(outcomes), left_out=left_out, include_cap=include_cap, table=table,
                    v_fra=thresholds, v_fra_per_seed=seed_thresholds,
-                   f_gro_by_offset=offset_table(groups))
+                   f_gro_by_offset=by_offset)
     if plot:
         pictures = plots.growth_efficiency(campaign / "growth_efficiency", dict(curves), thresholds,
                                           dict(counts))

@@ -75,6 +75,15 @@ def test_summary_is_the_b_off_weighted_average(campaign):
         b2, f = np.array(mine).T
         assert line["mean_f_gro"] == pytest.approx(float(b_off_average(b2, f)), rel=1e-12)
     assert len(read_csv(runs / "summary.csv")) == 2
+    # the paper's Fig. B.1 table: f_gro per B_off^2 (a row) and v_col (a column), seeds
+    # averaged, as runs.csv holds them with B_off^2 as a column
+    assert all(r["B_off2"] == pytest.approx(r["B_off"] ** 2, abs=1e-12) for r in rows)
+    by_offset = read_csv(runs / "f_gro_by_offset.csv")
+    for row in by_offset:
+        for line in summary["table"]:
+            same = [r["growth_efficiency"] for r in rows if r["v_col"] == line["v_col"]
+                    and abs(r["B_off2"] - row["B_off2"]) < 1e-4]
+            assert row[f"f_gro_{line['v_col']:g}"] == pytest.approx(np.mean(same), rel=1e-12)
     for name in ("growth_efficiency", "cumulative", "disruption", "compression"):
         assert (runs / f"{name}.png").stat().st_size > 0
     # at 2 m/s (0.6 v0, far below v_fra) the aggregates stick at every B_off that touches
@@ -261,10 +270,11 @@ def test_a_campaign_directory_belongs_to_one_spec(tmp_path):
 
 def test_failed_run_is_recorded_and_left_out_of_the_summary(tmp_path):
     spec = tmp_path / "spec.json"
-    # T_vis 10^6 times the paper's: the damping throws a contact's grains apart faster
-    # than the skin holds them in a step, and LAMMPS stops
-    spec.write_text(json.dumps(dict(SPEC, v_col=[20.0], b_off2=[0.0],
-                                    material_overrides={"tvis": 1e-6})))
+    # T_vis about t_c (45 times the paper's, the most jkrdt.units lets through) at dt 0.39
+    # t_c: the damping throws a contact's grains apart faster than the skin holds them in
+    # a step, and LAMMPS stops
+    spec.write_text(json.dumps(dict(SPEC, v_col=[20.0], b_off2=[0.0], dt=0.39,
+                                    material_overrides={"tvis": 2.7e-10})))
     assert run_campaign(spec, tmp_path / "runs", progress=False)["ran"] == 1
     out = json.loads(next((tmp_path / "runs").rglob("outcome.json")).read_text())
     assert out["stop_reason"] == "error" and "raise the skin above" in out["problem"]

@@ -304,6 +304,15 @@ def add_settle_options(p) -> None:
                         "below 10^4 grains)")
 
 
+def model_name(text: str) -> str:
+    """--model: one of scene.MODELS; any other name is told the paper's four models."""
+    if text not in scene_module.MODELS:
+        raise argparse.ArgumentTypeError(
+            f"unknown model {text!r}: use 'frictional' or 'frictionless'; the 3D paper's "
+            f"four models are {scene_module.PAPER_MODELS}")
+    return text
+
+
 def run(args) -> int:
     if args.dt == "auto":
         raise SystemExit("jkrdt: --dt auto belongs to jkrdt setup (it is written into the "
@@ -320,8 +329,8 @@ def demo(args) -> int:
 
     out = Path(args.out).resolve()
     try:
-        scene = Scene(material=material("ice"), n_tar=args.n, n_pro=args.n, v_col=args.v,
-                      b_off=args.b_off, seed=args.seed, model=args.model)
+        scene = Scene(material=material("ice", tvis=args.tvis), n_tar=args.n, n_pro=args.n,
+                      v_col=args.v, b_off=args.b_off, seed=args.seed, model=args.model)
     except ValueError as err:
         raise SystemExit(f"jkrdt: {err}") from None
     write_scene(scene, out, force=True)    # the demo's directory is its own
@@ -462,9 +471,12 @@ def main(argv=None) -> int:
     add_settle_options(d)
     d.add_argument("--np", type=int, default=1, help="MPI ranks")
     d.add_argument("--quiet", action="store_true", help="no line per settle check")
-    d.add_argument("--model", choices=list(scene_module.MODELS), default="frictional",
+    d.add_argument("--model", type=model_name, default="frictional",
                    help="Wada et al. (2007) with sliding, rolling, twisting (xi_crit = 8 A), "
-                        "or the frictionless model of the 3D BPCA paper")
+                        "or the frictionless model of the 3D BPCA paper; with --tvis 6e-12 "
+                        "the paper's damped ones")
+    d.add_argument("--tvis", type=float, default=0.0,
+                   help="viscoelastic time of eq. (A.5), s (the paper's 6 ps: 6e-12)")
     d.add_argument("--seed", type=int, default=1)
     d.add_argument("--out", default="runs/demo")
     st = sub.add_parser("setup", help="build two aggregates and write a collision scene")
@@ -475,7 +487,9 @@ def main(argv=None) -> int:
     st.add_argument("--v", type=float, default=20.0, help="collision speed, m/s")
     st.add_argument("--b-off", type=float, default=0.0, help="impact parameter B_off")
     add_material_options(st)
-    st.add_argument("--model", choices=list(scene_module.MODELS), default="frictional")
+    st.add_argument("--model", type=model_name, default="frictional",
+                    help="frictional or frictionless; with --tvis 6e-12 the 3D paper's "
+                         "damped models")
     st.add_argument("--seed", type=int, default=1)
     st.add_argument("--dt", type=time_step, default=None,
                     help="the scene's time step in units of t_c, or 'auto' to choose it from "

@@ -36,10 +36,11 @@ def grazing_cumulative(n, n_tar: int, n_pro: int):
     return n_tar * (n >= n_tar) + n_pro * (n >= n_pro)
 
 
-def twelfths(b_off2: float) -> str | None:
-    """B_off^2 as the paper writes it, "k/12", where it is a twelfth; else None."""
+def twelfths(b_off2: float, tolerance: float = 1e-6) -> str | None:
+    """B_off^2 as the paper writes it, "k/12", where it is a twelfth (within
+    ``tolerance`` of k; 1e-3 for a value written with 4 decimals); else None."""
     k = 12 * b_off2
-    return f"{round(k)}/12" if abs(k - round(k)) < 1e-6 else None
+    return f"{round(k)}/12" if abs(k - round(k)) < tolerance else None
 
 
 def offset_label(b_off: float) -> str:

@@ -20,12 +20,16 @@ import functools
 import numpy as np
 
 from . import collision
-from . import timestep
+from . import timestep, units
 from .aggregates import BUILDERS, check_fits
 from .materials import Material, scales
 from .timestep import PAPER_DT
 
 MODELS = ("frictional", "frictionless")
+#: the 3D BPCA paper's four models, as it names them, and how to ask for each
+PAPER_MODELS = ("frictional (model 'frictional'), frictional with normal dissipation "
+                "(model 'frictional', tvis 6e-12 s), frictionless ('frictionless'), "
+                "frictionless with normal dissipation ('frictionless', tvis 6e-12 s)")
 #: where the aggregates' bonds sit, as a fraction of delta_0: at the JKR equilibrium (at
 #: rest, the default), or touching (delta 1e-3 delta_0, just inside contact: each bond then
 #: pulls with about 0.9 F_c and the aggregates start with the energy of settling into it)
@@ -35,7 +39,8 @@ BONDS = {"equilibrium": 1.0, "touching": 1.0e-3}
 def pair_coeff(mat: Material, model: str = "frictional") -> str:
     """The words of ``pair_coeff * *`` for ``mat`` under ``model`` (SI units)."""
     if model not in MODELS:
-        raise ValueError(f"unknown model {model!r}: use 'frictional' or 'frictionless'")
+        raise ValueError(f"unknown model {model!r}: use 'frictional' or 'frictionless'; "
+                         f"the 3D paper's four models are {PAPER_MODELS}")
     words = [f"gamma {mat.gamma!r}", f"E {mat.E!r}", f"nu {mat.nu!r}"]
     if mat.G is not None:
         words.append(f"G {mat.G!r}")
@@ -106,6 +111,7 @@ class Scene:
         if self.gap is not None and not self.gap >= 0:
             raise ValueError(f"the initial gap must be >= 0 m (got {self.gap:g})")
         pair_coeff(self.material, self.model)          # the model fits the material
+        units.check(self)                              # SI values near grain scales
 
     @functools.cached_property
     def scales(self):
