@@ -9,6 +9,8 @@ from pathlib import Path
 
 import pytest
 
+from cut_off import RULE, straight_and_cut
+
 BIN = Path(sys.executable).parent
 JKRDT = str(BIN / "jkrdt")
 
@@ -45,24 +47,10 @@ def test_a_run_cut_off_continues_as_the_uninterrupted_one_and_a_finished_one_is_
     to its record, so that its analysis equals the uninterrupted run's (restarts are exact:
     tests/test_lifecycle.py); on a finished run it refuses without --force."""
     import json
-    import shutil
 
-    straight, cut = tmp_path / "straight", tmp_path / "cut"
-    subprocess.run([JKRDT, "setup", "--n-tar", "64", "--n-pro", "64", "--v", "20", "--out",
-                    str(straight)], check=True, capture_output=True, timeout=300)
-    shutil.copytree(straight, cut)
-    rule = ["--check", "10"]
-    subprocess.run([JKRDT, "run", str(straight), *rule], check=True, capture_output=True,
-                   timeout=600)
-    run = subprocess.Popen([JKRDT, "run", str(cut), *rule], stdout=subprocess.PIPE,
-                           stderr=subprocess.PIPE, text=True)
-    deadline = time.time() + 300
-    while not (cut / "restart.b").exists() and time.time() < deadline:
-        time.sleep(0.02)
-    time.sleep(0.3)                                  # a few more checks
-    run.send_signal(signal.SIGINT)
-    run.communicate(timeout=20)
-    assert run.returncode == 2 and not (cut / "final.restart").exists(), "ended before the cut"
+    straight, cut, returncode = straight_and_cut(tmp_path)
+    rule = RULE
+    assert returncode == 2 and not (cut / "final.restart").exists(), "ended before the cut"
     subprocess.run([JKRDT, "analyse", str(cut), "--partial", "--no-plots"], check=True,
                    capture_output=True, timeout=300)
     assert json.loads((cut / "outcome.json").read_text())["stop_reason"] == "cut off"

@@ -5,11 +5,8 @@ the same collision with nothing lost."""
 
 import json
 import os
-import shutil
-import signal
 import subprocess
 import sys
-import time
 import zlib
 from pathlib import Path
 
@@ -20,6 +17,8 @@ from jkrdt import rundir
 from jkrdt.analysis.tables import read_csv
 from jkrdt.materials import ICE
 from jkrdt.scene import Scene
+
+from cut_off import RULE, straight_and_cut
 
 BIN = Path(sys.executable).parent
 JKRDT = str(BIN / "jkrdt")
@@ -85,21 +84,8 @@ def test_a_run_cut_off_inside_a_frame_and_a_table_row_resumes_as_the_run(tmp_pat
     """jkrdt run stopped by a signal, then its compressed dumps given half a frame (a kill
     while gzip wrote) and its table half a row: the partial analysis reads what is whole,
     and the continued run's outcome is the uninterrupted one's."""
-    straight, cut = tmp_path / "straight", tmp_path / "cut"
-    subprocess.run([JKRDT, "setup", "--n-tar", "64", "--n-pro", "64", "--v", "20", "--out",
-                    str(straight)], check=True, capture_output=True, timeout=300)
-    shutil.copytree(straight, cut)
-    rule = ["--check", "10"]
-    subprocess.run([JKRDT, "run", str(straight), *rule], check=True, capture_output=True,
-                   timeout=600)
-    run = subprocess.Popen([JKRDT, "run", str(cut), *rule], stdout=subprocess.PIPE,
-                           stderr=subprocess.PIPE, text=True)
-    deadline = time.time() + 300
-    while not (cut / "restart.b").exists() and time.time() < deadline:
-        time.sleep(0.02)
-    time.sleep(0.3)
-    run.send_signal(signal.SIGINT)
-    run.communicate(timeout=30)
+    straight, cut, _ = straight_and_cut(tmp_path)
+    rule = RULE
     assert not (cut / rundir.FINAL_RESTART).exists(), "ended before the cut"
     # what a kill inside a write leaves: the compressed stream (flushed after each frame,
     # as LAMMPS does) ending inside a frame, cut mid-line, and a row without its end
