@@ -290,8 +290,7 @@ def prepare(directory: Path, spec: dict, scene: Scene, aggregates: dict):
         status = rundir.run_status(directory)
         if status.problem is None and status.stop_reason != "error":
             return "ended"
-    point = rundir.resume_point(directory, last_step(spec, rundir.read(directory))) \
-        if (directory / rundir.META).exists() else None
+    point = rundir.resume_point(directory, last_step(spec, scene))
     if point is not None:
         rundir.cut_back(directory, point[1])
         return point

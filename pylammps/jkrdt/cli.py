@@ -213,7 +213,7 @@ def run_held(out: Path, dt: float | None, steps: int | None, nproc: int, rule: S
                          f"at step {before.stop_step}); --force runs it again from the start, "
                          "replacing its record")
     if before is not None and before.stop_reason == "cut off" and not force:
-        resume = rundir.resume_point(out, int(variables["steps"]))
+        resume = rundir.resume_point(out, last_step)
     if resume is not None:
         restart, start = resume
         rundir.cut_back(out, start)

@@ -52,12 +52,11 @@ class CheckLines:
         except (OSError, KeyError, ValueError, IndexError):
             return None
 
-    def line(self, row: dict, wall: float | None) -> str:
+    def line(self, row: dict, wall: float | None, error: float | None) -> str:
         step = int(row["step"])
         words = [f"step {step}", f"t {row['time'] / self.t_c:.0f} t_c",
                  f"N_lar {int(row['n_largest'])}", f"fragments {int(row['n_fragments'])}",
                  f"contacts {int(row['contacts'])}"]
-        error = self.energy_error()
         if error is not None:
             words.append(f"|dE|/E_imp {error:.1e}")
         if wall is not None:
@@ -72,16 +71,17 @@ class CheckLines:
         """Print the checks that have appeared since the last poll. The wall times are the
         table's own (its ``wall`` column, the run's seconds at each check)."""
         table = complete_rows(self.out / rundir.CHECKS)
-        rows = [r for r in table if r["step"] > self.seen]
-        for row in rows:
+        new = [k for k, r in enumerate(table) if r["step"] > self.seen]
+        error = self.energy_error() if new else None    # the log, read once per poll
+        for k in new:
+            row = table[k]
             if self.first_step is None:
                 self.first_step, self.first_wall = int(row["step"]), row.get("wall", 0.0)
-            before = [r for r in table if r["step"] < row["step"]]
-            wall = row["wall"] - before[-1]["wall"] if before and "wall" in row else None
+            wall = row["wall"] - table[k - 1]["wall"] if k and "wall" in row else None
             if wall is not None and wall < 0:      # a table of an older build: its clock
                 wall = None                        # started again at a resume
                 self.first_step, self.first_wall = int(row["step"]), row["wall"]
-            text = self.line(row, wall)
+            text = self.line(row, wall, error)
             if self.bar is not None:
                 self.bar.write(text)
                 self.bar.update(int(row["step"]) - self.seen)
