@@ -123,7 +123,8 @@ def _when(step, time, t_c) -> str:
 
 def outcome(path, start: np.ndarray, end: np.ndarray, body: np.ndarray, labels: np.ndarray,
             radius: float, dim: int, when: tuple, t_c: float, b: float | None = None,
-            title: str = "", departed: np.ndarray | None = None) -> list[Path]:
+            title: str = "", departed: np.ndarray | None = None,
+            end_label: str = "end") -> list[Path]:
     """The collision at its first and last frame (columns), in x-y and, in 3D, x-z
     (rows), grains to scale. At the start the target and the projectile have their own
     colours, with the impact direction (the projectile moves along -x) and the offset b
@@ -176,7 +177,7 @@ def outcome(path, start: np.ndarray, end: np.ndarray, body: np.ndarray, labels: 
         _discs(e, end[big], i, j, d, colours[big], zorder=2)
         marked = _mark_small(e, end, labels, i, j)
     axes[0, 0].set_title("start, " + _when(*when[0], t_c), fontsize=10)
-    axes[0, 1].set_title("end, " + _when(*when[1], t_c), fontsize=10)
+    axes[0, 1].set_title(f"{end_label}, " + _when(*when[1], t_c), fontsize=10)
     axes[0, 0].legend(handles=[Patch(color=BODY_COLOURS[1], label=f"target ({tar.sum()})"),
                                Patch(color=BODY_COLOURS[2], label=f"projectile ({pro.sum()})"),
                                Line2D([], [], color="k", marker=">", label="projectile's motion")],
@@ -211,10 +212,11 @@ def outcome(path, start: np.ndarray, end: np.ndarray, body: np.ndarray, labels: 
 
 
 def timeline(path, rows: list[dict], n_total: int, e_imp: float, t_c: float,
-             title: str = "") -> list[Path]:
+             title: str = "", last_frame: float | None = None) -> list[Path]:
     """N_lar and the second largest, the number of fragments, n_con and the energy shares
     against time, from the per-frame rows of ``frames.csv`` (the energies and the time
-    come from the run's log; without one, against the step)."""
+    come from the run's log; without one, against the step). ``last_frame`` (s): the time
+    of the last atom frame, marked when the rows go on past it (a partial analysis)."""
     plt = _pyplot()
     has_time = all("time" in r for r in rows)
     x = np.array([r["time"] * 1e9 if has_time else r["step"] for r in rows], dtype=float)
@@ -240,6 +242,11 @@ def timeline(path, rows: list[dict], n_total: int, e_imp: float, t_c: float,
                      label="potential - U(0)")
         axes[3].set_ylabel("energy / E_imp")
         axes[3].legend(fontsize=8)
+    if last_frame is not None and has_time:
+        for ax in axes:
+            ax.axvline(last_frame * 1e9, color="0.4", ls="--", lw=1)
+        axes[0].annotate("last atom frame", (last_frame * 1e9, 0.02), fontsize=8,
+                         color="0.3", ha="right", rotation=90, va="bottom")
     axes[-1].set_xlabel("time (ns)" if has_time else "step")
     if has_time:
         top = axes[0].secondary_xaxis("top", functions=(lambda ns: ns * 1e-9 / t_c,

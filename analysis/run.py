@@ -20,7 +20,7 @@ import numpy as np
 
 from jkrdt import rundir
 from jkrdt.protocol import offset_label
-from jkrdt.rundir import read_thermo, run_status
+from jkrdt.rundir import IN_PROGRESS, read_thermo, run_status
 from jkrdt.ledger import CHANNELS, contact_events, energy_budget, energy_error
 from jkrdt.stopping import ENERGY_WARN, STOP_WORDS
 
@@ -64,9 +64,9 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
     meta = rundir.read_metadata(run)
     scene = rundir.from_metadata(meta)
     status = run_status(run)
-    if status.stop_reason == "error" and not partial:
+    if status.stop_reason in ("error", IN_PROGRESS) and not partial:
         raise RunNotComplete(f"{run}: {status.problem}; analyse what is there with --partial")
-    mat, s = scene.material, scene.scales
+    s = scene.scales
     tolerance = s.delta_c if tolerance is None else tolerance
     n_tar, n_pro = scene.n_tar, scene.n_pro
     budget, thermo = None, None
@@ -88,8 +88,13 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
                                 tolerance=tolerance).run(frames=every).results
     dumped = [{name: measured[name][k].item() for name in CollisionOutcome.MEASURES}
               for k in range(len(measured.step))]
-    last_dumped = dumped[-1]["step"] if dumped else None
-    rows = [r for r in table if last_dumped is None or r["step"] <= last_dumped] or dumped
+    if not dumped:
+        raise ValueError(f"{atoms} has no frames"
+                         + (f" ({status.problem})" if status.problem else ""))
+    last_frame = dumped[-1]["step"]
+    # the timeline is the table's (every check, also past the last atom frame of a run
+    # cut off or under way), or the frames' for a run without the settle rule
+    rows = [r for r in table if partial or r["step"] <= last_frame] or dumped
     for row in rows:
         if budget is not None:
             at = np.flatnonzero(thermo["Step"] == row["step"])
@@ -100,13 +105,12 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
                 events = contact_events(thermo, int(at[0]))
                 if events is not None:            # N_con, N_cut so far (App. C.2)
                     row.update(N_con=events["N_con"], N_cut=events["N_cut"])
-    if not dumped:
-        raise ValueError(f"{atoms} has no frames"
-                         + (f" ({status.problem})" if status.problem else ""))
-    last_step = last_dumped
-    final = dumped[-1]
-    labels, x_last = measured.labels, measured.positions
-    status = run_status(run, last_dump_step=last_step)
+    # the outcome: at the last atom frame, or at the last check after it (a partial one)
+    last_step = max(last_frame, int(rows[-1]["step"]))
+    final = dumped[-1] if last_step == last_frame else \
+        {name: rows[-1][name] for name in CollisionOutcome.MEASURES}
+    if status.stop_reason != IN_PROGRESS:
+        status = run_status(run, last_dump_step=last_frame)
     if status.problem and not partial:
         raise RunNotComplete(f"{run}: {status.problem}; analyse what is there with --partial")
     n_k = n_tar + n_pro - 2
@@ -117,58 +121,79 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
                contacts_source="contact list" if measured.has_contacts else
                f"positions, r_i + r_j + {tolerance:.3e} m")
     out.update(stop_reason=status.stop_reason, stop_step=status.stop_step,
-               last_step=last_step, settled=status.stop_reason == "settled",
-               problem=status.problem)
+               last_step=last_step, last_frame_step=last_frame,
+               outcome_from="atom frame" if last_step == last_frame else "settle check",
+               settled=status.stop_reason == "settled", problem=status.problem)
     if budget is not None:
-        e_imp = meta["E_imp"]
-        upto = thermo["Step"] <= last_step
-        at = np.flatnonzero(thermo["Step"] == last_step)
-        left = budget["kinetic"][at[0]] if at.size else budget["kinetic"][upto][-1]
-        error = energy_error(budget, e_imp)
-        t_end = float(thermo["Time"][at[0]] if at.size else thermo["Time"][upto][-1])
-        out.update(time_end=t_end, time_end_over_tc=t_end / s.t_c)
-        end = int(at[0]) if at.size else int(np.flatnonzero(upto)[-1])
-        gone = budget["departed"][end]
-        # the partition of the energy at the start, at the end: kinetic_start = kinetic_left
-        # + potential_change + dissipated_fraction - energy_drift (all / E_imp)
-        out.update(kinetic_start=float(budget["kinetic"][0] / e_imp),
-                   kinetic_left=float(left / e_imp), kinetic_departed=float(gone / e_imp),
-                   potential_change=float((budget["potential"][end] - budget["potential"][0])
-                                          / e_imp),
-                   energy_drift=float((budget["total"][end] - budget["total"][0]) / e_imp),
-                   energy_error=error,
-                   energy_warning=error > ENERGY_WARN,
-                   dissipated_fraction=float(budget["dissipated"][end] / e_imp),
-                   dissipated_by_channel={name: float(budget[name][end] / e_imp)
-                                          for name in CHANNELS})
-        # N_con, N_cut (3D BPCA paper, App. C.2) at the analysed end; the bonded contacts
-        # then less those at the start are N_con - N_cut exactly
-        events = contact_events(thermo, end)
-        if events is not None:
-            out.update(events)
+        out.update(energies_at(budget, thermo, last_step, meta["E_imp"], s.t_c))
     write_csv(run / rundir.FRAMES, rows)
     if plots:
-        title = (f"{mat.name} {scene.kind.upper()} {n_tar}+{n_pro}, "
-                 f"v = {scene.v_col:g} m/s, {offset_label(scene.b_off)}, {scene.model}"
-                 + (f", T_vis = {mat.tvis * 1e12:g} ps" if mat.tvis > 0 else ""))
-        when = f"{status.stop_reason} at step {last_step}"
-        if "time_end" in out:
-            when += (f", t = {out['time_end'] * 1e9:.0f} ns = {out['time_end_over_tc']:.0f} t_c; "
-                     f"max |dE|/E_imp = {out['energy_error']:.1e}")
-        step_s = scene.time_step()[0] * s.t_c          # the time of a frame without a log
-        moments = [(r["step"], r.get("time", r["step"] * step_s)) for r in (rows[0], rows[-1])]
-        pictures = outcome(run / "outcome", measured.first_positions,
-                           flown(x_last, measured, moments[1][1]), measured.types,
-                           labels, scene.radius, scene.dim, moments, s.t_c, b=meta.get("b"),
-                           title=f"{title}\n{when}", departed=measured.departed_at > 0)
-        pictures += timeline(run / "timeline", rows, n_tar + n_pro, meta["E_imp"], s.t_c, title)
-        if budget is not None:
-            pictures += energy_partition(run / "energy", thermo["Time"], budget, meta["E_imp"],
-                                         title)
-        out["pictures"] = [str(p) for p in pictures]
+        out["pictures"] = pictures(run, scene, meta, out, rows, measured, thermo, budget)
     out["diagnostics"] = diagnostics(out)
     rundir.write_outcome(run, out)
     return out
+
+
+def energies_at(budget: dict, thermo: dict, step: int, e_imp: float, t_c: float) -> dict:
+    """The energy partition at ``step`` (or the last thermo line before it), over E_imp,
+    with the energy error over the run and N_con, N_cut so far."""
+    upto = thermo["Step"] <= step
+    at = np.flatnonzero(thermo["Step"] == step)
+    end = int(at[0]) if at.size else int(np.flatnonzero(upto)[-1])
+    t_end = float(thermo["Time"][end])
+    error = energy_error(budget, e_imp)
+    # the partition of the energy at the start, at the end: kinetic_start = kinetic_left
+    # + potential_change + dissipated_fraction - energy_drift (all / E_imp)
+    out = dict(time_end=t_end, time_end_over_tc=t_end / t_c,
+               kinetic_start=float(budget["kinetic"][0] / e_imp),
+               kinetic_left=float(budget["kinetic"][end] / e_imp),
+               kinetic_departed=float(budget["departed"][end] / e_imp),
+               potential_change=float((budget["potential"][end] - budget["potential"][0])
+                                      / e_imp),
+               energy_drift=float((budget["total"][end] - budget["total"][0]) / e_imp),
+               energy_error=error, energy_warning=error > ENERGY_WARN,
+               dissipated_fraction=float(budget["dissipated"][end] / e_imp),
+               dissipated_by_channel={name: float(budget[name][end] / e_imp)
+                                      for name in CHANNELS})
+    # N_con, N_cut (3D BPCA paper, App. C.2) at the analysed end; the bonded contacts
+    # then less those at the start are N_con - N_cut exactly
+    events = contact_events(thermo, end)
+    if events is not None:
+        out.update(events)
+    return out
+
+
+def pictures(run: Path, scene, meta: dict, out: dict, rows: list[dict], measured, thermo,
+             budget) -> list[str]:
+    """outcome.png (the start and the last atom frame), timeline.png (every row, with the
+    last atom frame marked when the outcome is a later check's) and energy.png."""
+    mat, s = scene.material, scene.scales
+    n_total = scene.n_tar + scene.n_pro
+    title = (f"{mat.name} {scene.kind.upper()} {scene.n_tar}+{scene.n_pro}, "
+             f"v = {scene.v_col:g} m/s, {offset_label(scene.b_off)}, {scene.model}"
+             + (f", T_vis = {mat.tvis * 1e12:g} ps" if mat.tvis > 0 else ""))
+    when = f"{out['stop_reason']} at step {out['last_step']}"
+    if "time_end" in out:
+        when += (f", t = {out['time_end'] * 1e9:.0f} ns = {out['time_end_over_tc']:.0f} t_c; "
+                 f"max |dE|/E_imp = {out['energy_error']:.1e}")
+    frame = out["last_frame_step"]
+    step_s = scene.time_step()[0] * s.t_c          # the time of a frame without a log
+    frame_row = next((r for r in rows if r["step"] == frame), None)
+    frame_time = frame_row.get("time", frame * step_s) if frame_row else frame * step_s
+    moments = [(rows[0]["step"], rows[0].get("time", rows[0]["step"] * step_s)),
+               (frame, frame_time)]
+    if frame != out["last_step"]:
+        when += f"\natoms drawn at step {frame}, the last atom frame"
+    made = outcome(run / "outcome", measured.first_positions,
+                   flown(measured.positions, measured, frame_time), measured.types,
+                   measured.labels, scene.radius, scene.dim, moments, s.t_c, b=meta.get("b"),
+                   title=f"{title}\n{when}", departed=measured.departed_at > 0,
+                   end_label="end" if frame == out["last_step"] else "last atom frame")
+    made += timeline(run / "timeline", rows, n_total, meta["E_imp"], s.t_c, title,
+                     last_frame=None if frame == out["last_step"] else frame_time)
+    if budget is not None:
+        made += energy_partition(run / "energy", thermo["Time"], budget, meta["E_imp"], title)
+    return [str(p) for p in made]
 
 
 def summary_text(out: dict) -> str:
@@ -187,11 +212,16 @@ def summary_text(out: dict) -> str:
            else ""),
     ]
     ended = STOP_WORDS[out["stop_reason"]]
-    lines.append(f"run ended                   {ended} at step {out['stop_step']}"
+    lines.append(f"the run                     {ended} at step {out['stop_step']}"
                  + (f" (analysed up to step {out['last_step']})"
                     if out["last_step"] != out["stop_step"] else "")
                  + (f", t = {out['time_end'] * 1e9:.0f} ns = {out['time_end_over_tc']:.0f} t_c"
                     if "time_end" in out else ""))
+    frame = out.get("last_frame_step", out["last_step"])
+    if frame != out["last_step"]:
+        lines.append(f"outcome from                the settle check at step {out['last_step']} "
+                     f"(checks.csv, log.lammps); the last atom frame is at step {frame}, "
+                     "where N_cum and the picture are")
     if out.get("problem"):
         lines.append(f"  WARNING                   {out['problem']}; partial outcome")
     if "kinetic_left" in out:

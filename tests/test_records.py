@@ -19,7 +19,8 @@ def test_stopping_jkrdt_run_stops_its_lammps(tmp_path):
     d = tmp_path / "scene"
     subprocess.run([JKRDT, "setup", "--n-tar", "64", "--n-pro", "64", "--v", "20", "--out",
                     str(d)], check=True, capture_output=True, timeout=300)
-    run = subprocess.Popen([JKRDT, "run", str(d), "--steps", "50000000"],
+    # on 2 ranks: mpirun's banner about ranks it saw killed is not shown
+    run = subprocess.Popen([JKRDT, "run", str(d), "--steps", "50000000", "--np", "2"],
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     log = d / "log.lammps"
     deadline = time.time() + 120
@@ -27,9 +28,11 @@ def test_stopping_jkrdt_run_stops_its_lammps(tmp_path):
         time.sleep(0.1)
     time.sleep(1.0)                                  # well inside the run
     run.send_signal(signal.SIGTERM)
-    _, err = run.communicate(timeout=20)
-    assert run.returncode == 2 and err.count("\n") == 1, err
-    assert "stopped by SIGTERM, and LAMMPS with it" in err
+    t0 = time.time()
+    out, err = run.communicate(timeout=20)
+    assert time.time() - t0 < 5, "LAMMPS must end within 5 s of the signal"
+    assert run.returncode == 2 and err.count("\n") == 1 and "BAD TERMINATION" not in out, err
+    assert "stopped by SIGTERM, and LAMMPS with it" in err and f"'jkrdt run {d}'" in err
     # no LAMMPS left writing: no process names the scene, and the log holds still
     size = log.stat().st_size
     time.sleep(2.0)
@@ -121,11 +124,44 @@ def test_stopping_a_campaign_stops_its_lammps_at_once(tmp_path, how):
     _, err = proc.communicate(timeout=20)
     assert time.time() - t0 < 5 and proc.returncode == -how, (proc.returncode, err)
     assert "Traceback" not in err
+    # what it left, and how to resume it
+    assert f"campaign stopped by {how.name}" in err and "0 of 1 runs finished, 1 cut off" in err
+    assert f"cut off, resumes from its last restart file: {run}" in err
+    assert f"'jkrdt campaign {spec} {tmp_path / 'c'} --quiet' resumes it" in err
     size = (run / rundir.LOG).stat().st_size
     time.sleep(1.0)
     assert (run / rundir.LOG).stat().st_size == size      # no LAMMPS left writing
     assert rundir.run_status(run).stop_reason == "cut off"
     assert not rundir.finished(run)
+
+
+def test_stopping_a_campaign_on_two_ranks_says_what_it_left_without_mpiruns_banner(tmp_path):
+    import json
+
+    from jkrdt import rundir
+    from jkrdt.campaign import run_directory
+
+    spec = tmp_path / "spec.json"
+    spec.write_text(json.dumps(dict(n_tar=64, n_pro=64, v_col=[20.0], b_off2=[0.0, 0.25],
+                                    seeds=[2], settle=dict(check_tc=5, cap_tc=4000))))
+    runs = [run_directory(tmp_path / "c", 20.0, b2, 2) for b2 in (0.0, 0.25)]
+    proc = subprocess.Popen([JKRDT, "campaign", str(spec), str(tmp_path / "c"), "--np", "2"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    wait_for(runs[0] / "restart.b")
+    proc.send_signal(signal.SIGTERM)
+    t0 = time.time()
+    out, err = proc.communicate(timeout=20)
+    assert time.time() - t0 < 5 and proc.returncode == 2, (proc.returncode, err)
+    assert "BAD TERMINATION" not in out + err and "Traceback" not in err, out + err
+    done = sum(rundir.finished(r) for r in runs)
+    cut = [r for r in runs if not rundir.finished(r) and (r / rundir.LOG).exists()]
+    assert cut, "the campaign was stopped while a run went"
+    assert (f"{done} of 2 runs finished, {len(cut)} cut off, {2 - done - len(cut)} not "
+            "started") in err, err
+    assert all(f"resumes from its last restart file: {r}" in err for r in cut)
+    assert f"'jkrdt campaign {spec} {tmp_path / 'c'} --np 2' resumes it" in err
+    left = subprocess.run(["pgrep", "-f", str(tmp_path)], capture_output=True, text=True)
+    assert left.stdout == "", left.stdout
 
 
 SESSION_SCRIPT = """

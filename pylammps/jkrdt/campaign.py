@@ -262,6 +262,20 @@ def plan(spec: dict, campaign) -> list[tuple[float, float, int, Path]]:
             for seed in spec["seeds"] for v in spec["v_col"] for b2 in spec["b_off2"]]
 
 
+def left(spec_path, campaign) -> str:
+    """What a stopped campaign leaves, in a few lines: the runs finished (and failed), those
+    cut off (to be resumed), and how many have not started."""
+    todo = plan(read_spec(spec_path), campaign)
+    done = [d for *_, d in todo if rundir.finished(d)]
+    failed = [d for d in done if rundir.failed(d)]
+    cut = [d for *_, d in todo if not rundir.finished(d) and (d / rundir.LOG).exists()]
+    lines = [f"{len(done)} of {len(todo)} runs finished"
+             + (f" ({len(failed)} failed)" if failed else "")
+             + f", {len(cut)} cut off, {len(todo) - len(done) - len(cut)} not started"]
+    lines += [f"  cut off, resumes from its last restart file: {d}" for d in cut]
+    return "\n".join(lines)
+
+
 def scene_of(spec: dict, v: float, b2: float, seed: int) -> Scene:
     """The scene of one run of the grid."""
     auto = spec["dt"] == "auto"

@@ -46,7 +46,12 @@ def run_lammps(deck: Path, out: Path, variables: dict, nproc: int = 1, watch=Non
         cmd += ["-var", k, str(v)]
     if nproc > 1:
         cmd = [str(Path(sys.executable).parent / "mpirun"), "-np", str(nproc)] + cmd
-    returncode = run_stoppable(cmd, out, watch.poll if watch is not None else None)
+    try:
+        returncode = run_stoppable(cmd, out, watch.poll if watch is not None else None)
+    except Stopped as stop:
+        raise SystemExit(f"jkrdt: stopped by {stop.how.name}, and LAMMPS with it: the run in "
+                         f"{out} is cut off, kept to its last restart file; 'jkrdt run {out}' "
+                         "continues it") from None
     if watch is not None:
         watch.close()
     if returncode != 0:
@@ -58,36 +63,83 @@ def run_lammps(deck: Path, out: Path, variables: dict, nproc: int = 1, watch=Non
 STOPPING = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
 
-def run_stoppable(cmd: list[str], cwd: Path, poll=None) -> int:
+def run_stoppable(cmd: list[str], cwd: Path, poll=None, echo: bool = False) -> int:
     """Run ``cmd`` (LAMMPS, or mpirun and its ranks) in a process group of its own and wait
-    for it, calling ``poll()`` about once a second meanwhile; SIGINT, SIGTERM or SIGHUP to
-    this process stops the whole group with it (TERM, then KILL after 5 s), so that no
-    LAMMPS goes on writing a run nobody waits for."""
-    child = subprocess.Popen(cmd, cwd=cwd, start_new_session=True)
+    for it, calling ``poll()`` about once a second meanwhile. SIGINT, SIGTERM or SIGHUP to
+    this process stops the whole group with it (TERM, then KILL after ``STOP_GRACE``
+    s), so that no LAMMPS goes on writing a run nobody waits for, and then exits with
+    ``Stopped``. What the group prints goes to a file: it is shown (``echo``: as it
+    comes) unless the group was stopped, so that mpirun's banner about ranks it saw
+    killed does not bury the stop's own line."""
+    import tempfile
 
-    def stop(signum, _frame):
-        for how in (signal.SIGTERM, signal.SIGKILL):
+    stopped: list[int] = []
+
+    def stop(signum, _frame):          # only note it: the loop below stops the group
+        if not stopped:
+            stopped.append(signum)
             try:
-                os.killpg(child.pid, how)
-                child.wait(timeout=5)
-                break
+                os.killpg(child.pid, signal.SIGTERM)
             except ProcessLookupError:
-                break
-            except subprocess.TimeoutExpired:
-                continue
-        raise SystemExit(f"jkrdt: stopped by {signal.Signals(signum).name}, and LAMMPS with "
-                         f"it: the run in {cwd} is cut off (jkrdt run starts it again)")
+                pass
 
-    before = {s: signal.signal(s, stop) for s in STOPPING}
-    try:
-        while True:
-            try:
-                return child.wait(timeout=None if poll is None else 1.0)
-            except subprocess.TimeoutExpired:
-                poll()
-    finally:
-        for s, handler in before.items():
-            signal.signal(s, handler)
+    with tempfile.TemporaryFile("w+b") as said:
+        child = subprocess.Popen(cmd, cwd=cwd, start_new_session=True, stdout=said,
+                                 stderr=subprocess.STDOUT)
+        shown = 0
+
+        def show(upto=None):
+            nonlocal shown
+            said.flush()
+            with open(said.fileno(), "rb", closefd=False) as f:
+                f.seek(shown)
+                text = f.read() if upto is None else f.read(max(0, upto - shown))
+            whole = text if upto is None else text[: text.rfind(b"\n") + 1]
+            shown += len(whole)
+            sys.stdout.write(whole.decode(errors="replace"))
+            sys.stdout.flush()
+
+        before = {s: signal.signal(s, stop) for s in STOPPING}
+        try:
+            since = None
+            while True:
+                try:
+                    returncode = child.wait(timeout=0.2 if stopped else 1.0)
+                    break
+                except subprocess.TimeoutExpired:
+                    pass
+                if stopped:
+                    since = since or time.time()
+                    if time.time() - since > STOP_GRACE:
+                        try:
+                            os.killpg(child.pid, signal.SIGKILL)
+                        except ProcessLookupError:
+                            pass
+                    continue
+                if echo:
+                    show(os.fstat(said.fileno()).st_size)
+                if poll is not None:
+                    poll()
+        finally:
+            for s, handler in before.items():
+                signal.signal(s, handler)
+        if stopped:
+            raise Stopped(signal.Signals(stopped[0]))
+        if echo or returncode != 0:
+            show()
+    return returncode
+
+
+#: seconds a stopped LAMMPS (or mpirun) has to end after SIGTERM before it is killed
+STOP_GRACE = 3.0
+
+
+class Stopped(SystemExit):
+    """A command stopped by a signal, its LAMMPS with it; its one line is the caller's."""
+
+    def __init__(self, how: signal.Signals):
+        super().__init__(128 + how.value)
+        self.how = how
 
 
 def output_interval(steps: int) -> int:
@@ -175,26 +227,28 @@ def write_scene(scene: Scene, out, tolerance: float | None = None, force: bool =
 
 
 def run_scene(out: Path, dt: float | None, steps: int | None, nproc: int,
-              rule: SettleRule = DEFAULT_RULE, force: bool = False, quiet: bool = False) -> None:
+              rule: SettleRule = DEFAULT_RULE, force: bool = False, quiet: bool = False,
+              frames: int | None = None) -> None:
     """Run the scene in ``out`` with its own deck, in its own directory: until it
     settles by ``rule`` (the cap included), or ``steps`` steps when given; ``dt`` (t_c)
     overrides the scene's time step. A run that was cut off continues from its newer
     restart file, adding to its record; a finished run is refused unless ``force``, which
     runs it again from the start. Unless ``quiet``, a line per settle check shows the run
-    (``jkrdt.progress``). Another process running ``out`` is refused (its claim,
-    ``rundir.hold``); a run that ends cut off exits non-zero."""
+    (``jkrdt.progress``). ``frames``: checks between atom frames (the deck's ``frames``
+    when None). Another process running ``out`` is refused (its claim, ``rundir.hold``);
+    a run that ends cut off exits non-zero."""
     try:
         held = rundir.hold(out)
     except rundir.RunHeld as err:
         raise SystemExit(f"jkrdt: {err}") from None
     try:
-        run_held(out, dt, steps, nproc, rule, force, quiet)
+        run_held(out, dt, steps, nproc, rule, force, quiet, frames)
     finally:
         held.close()
 
 
 def run_held(out: Path, dt: float | None, steps: int | None, nproc: int, rule: SettleRule,
-             force: bool, quiet: bool) -> None:
+             force: bool, quiet: bool, frames: int | None = None) -> None:
     """run_scene's work, with the directory's claim held."""
     from .progress import CheckLines
 
@@ -204,6 +258,8 @@ def run_held(out: Path, dt: float | None, steps: int | None, nproc: int, rule: S
     ratio = scene.time_step(dt)[0]
     if steps is None:
         variables.update(rule.deck_variables(ratio))
+        if frames is not None:
+            variables.update(frames=frames)
     else:
         variables.update(rundir.fixed_steps(steps, output_interval(steps)))
     before = rundir.run_status(out) if (out / rundir.LOG).exists() else None
@@ -319,8 +375,10 @@ def run(args) -> int:
                          "scene); jkrdt run takes a number of t_c or the scene's dt")
     if args.steps is not None and args.steps < 1:
         raise SystemExit(f"jkrdt: --steps must be >= 1 (got {args.steps})")
+    if args.frames is not None and args.frames < 1:
+        raise SystemExit(f"jkrdt: --frames is a number of settle checks >= 1 (got {args.frames})")
     run_scene(Path(args.dir).resolve(), args.dt, args.steps, args.np, settle_rule(args),
-              force=args.force, quiet=args.quiet)
+              force=args.force, quiet=args.quiet, frames=args.frames)
     return 0
 
 
@@ -356,17 +414,81 @@ def analyse(args) -> int:
     return 0
 
 
+def resume_command(args) -> str:
+    """The command line that resumes the campaign this process runs (never --fresh)."""
+    import shlex
+
+    words = [w for w in args.argv if w != "--fresh"]
+    return shlex.join(["jkrdt", *words])
+
+
+def campaign_stopped(args, how: signal.Signals) -> str:
+    return (f"jkrdt: campaign stopped by {how.name}, and its LAMMPS with it: "
+            f"{campaign_module.left(args.spec, args.dir)}\n"
+            f"jkrdt: '{resume_command(args)}' resumes it (finished runs are kept)")
+
+
+def stop_at_once(say) -> None:
+    """Make each of STOPPING end this process at once, by the signal, after ``say(how)``
+    (None: silently). A campaign's LAMMPS runs in this process and holds the main thread
+    in C for a whole chunk, where no Python handler runs; but Python's C-level handler
+    writes each signal to the wakeup fd in whatever thread takes it, so a thread of our
+    own reads it there, says what was left, and lets the signal end the process with its
+    default action (SIGHUP too, where the parent ignored it)."""
+    import ctypes
+    import threading
+
+    woken, wake = os.pipe()
+    os.set_blocking(wake, False)
+    signal.set_wakeup_fd(wake, warn_on_full_buffer=False)
+    for how in STOPPING:
+        signal.signal(how, lambda *_: None)      # the wakeup fd does the work
+
+    def wait():
+        how = signal.Signals(os.read(woken, 1)[0])
+        try:
+            if say is not None:
+                print(say(how), file=sys.stderr, flush=True)
+        finally:
+            sys.stdout.flush()
+            ctypes.CDLL(None).signal(int(how), 0)      # SIG_DFL, set from this thread
+            os.kill(os.getpid(), how)
+            os._exit(128 + how.value)
+
+    threading.Thread(target=wait, name="jkrdt-stop", daemon=True).start()
+
+
+def campaign_under_mpirun(args) -> int:
+    """jkrdt campaign --np N: the campaign under mpirun -np N, its lines shown as they
+    come; a signal stops it with one account of what was left, without mpirun's banner."""
+    inner, skip = [], False
+    for w in args.argv:                           # the same command, less --np N
+        if skip:
+            skip = False
+        elif w == "--np":
+            skip = True
+        elif not w.startswith("--np="):
+            inner.append(w)
+    cmd = [str(Path(sys.executable).parent / "mpirun"), "-np", str(args.np),
+           str(Path(sys.executable).parent / "jkrdt"), *inner]
+    try:
+        return run_stoppable(cmd, Path.cwd(), echo=True)
+    except Stopped as stop:
+        raise SystemExit(campaign_stopped(args, stop.how)) from None
+
+
 def campaign(args) -> int:
     from .campaign import run_campaign
 
+    if args.np > 1:
+        return campaign_under_mpirun(args)
     from mpi4py import MPI
 
     # the campaign's LAMMPS runs in this process: each of STOPPING ends it at once (SIGINT
-    # too, not when the current chunk returns to Python; SIGHUP even where the parent
-    # ignored it), leaving the run under way cut off for the next campaign to resume
-    for how in STOPPING:
-        signal.signal(how, signal.SIG_DFL)
-
+    # too, not when the current chunk returns to Python), leaving the run under way cut
+    # off for the next campaign to resume; the first rank says what was left
+    stop_at_once((lambda how: campaign_stopped(args, how)) if MPI.COMM_WORLD.rank == 0
+                 else None)
     done = run_campaign(args.spec, args.dir, progress=not args.quiet,
                         ranks_per_run=args.ranks_per_run, fresh=args.fresh,
                         retry_failed=args.retry_failed)
@@ -518,6 +640,9 @@ def main(argv=None) -> int:
                          "model is the scene's, set by jkrdt setup --model")
     rn.add_argument("--np", type=int, default=1, help="MPI ranks")
     rn.add_argument("--quiet", action="store_true", help="no line per settle check")
+    rn.add_argument("--frames", type=int, default=None,
+                    help="atoms and contacts dumped every this many settle checks and at the "
+                         "end (default: the deck's variable frames)")
     rn.add_argument("--force", action="store_true",
                     help="run a finished run again from the start, replacing its record (a "
                          "run that was cut off continues without it)")
@@ -538,6 +663,9 @@ def main(argv=None) -> int:
     cp.add_argument("--ranks-per-run", type=int, default=1,
                     help="MPI ranks per collision under mpirun -np N: N / K collisions run "
                          "side by side (default %(default)d)")
+    cp.add_argument("--np", type=int, default=1,
+                    help="MPI ranks: runs the campaign under mpirun -np N (default 1; or "
+                         "start it as mpirun -np N jkrdt campaign ...)")
     cp.add_argument("--quiet", action="store_true", help="no line per finished run")
     cp.add_argument("--fresh", action="store_true",
                     help="delete the runs the directory holds (of this or another spec) and "
@@ -552,8 +680,9 @@ def main(argv=None) -> int:
                     help="average in the runs that hit the settle cap (left out by default)")
     parser.add_argument("--debug", action="store_true",
                         help="show the Python traceback of an error instead of one line")
-    args = parser.parse_args(negative_values_joined(sys.argv[1:] if argv is None
-                                                    else [str(a) for a in argv]))
+    words = negative_values_joined(sys.argv[1:] if argv is None else [str(a) for a in argv])
+    args = parser.parse_args(words)
+    args.argv = words
     command = {"demo": demo, "build": build, "setup": setup, "run": run, "analyse": analyse,
                "campaign": campaign, "summarise": summarise}[args.command]
     try:

@@ -14,13 +14,15 @@ scene itself, a value that knows no files.
     restart.a, restart.b               restart files of a run under way, alternately
     final.restart, final.dump.gz       the end state, written when the run ends
     frames.csv, outcome.json, outcome/energy/timeline .png/.pdf   the analysis
-    .claim             a campaign's lock on the run while it goes
+    .claim             the lock of the process that runs it (jkrdt run, a Session, a
+                       campaign): ``claim``, ``hold``, ``running``
 
 The columns and fields of each record are described in ``docs/records.md``.
 
 A run is finished when ``outcome.json`` exists (written last, atomically) and holds no
 ``stop_reason`` "error"; a run that failed has one of the same schema (``parameters``)
-with the error as its ``problem``. A run that was cut off has none: it is continued from
+with the error as its ``problem``. A run that was cut off has none (or that of a partial
+analysis, stop_reason "cut off" or "in progress", which does not count): it is continued from
 its newer whole restart file, its record cut back to that step (``resume_point``,
 ``cut_back``, ``continuation``).
 """
@@ -253,9 +255,14 @@ def read_thermo(log) -> dict:
     return {name: data[:, k] for k, name in enumerate(names)}
 
 
+#: the stop reason of a run that a live process is running now (its claim is held)
+IN_PROGRESS = "in progress"
+
+
 @dataclasses.dataclass
 class RunStatus:
-    """Why a run stopped: settled, cap, steps (its fixed steps), error or cut off."""
+    """Why a run stopped: settled, cap, steps (its fixed steps), error or cut off; or that
+    it has not stopped yet (``IN_PROGRESS``)."""
 
     stop_reason: str
     stop_step: int | None       # the step the run ended at (None if unknown)
@@ -283,7 +290,10 @@ def run_status(run, last_dump_step: int | None = None) -> RunStatus:
     (``FINISH_LINE``), which the deck's end part (``label finish``, also what a Session
     runs when it closes) prints after writing the last frames and final.restart."""
     log = Path(run) / LOG
+    holder = running(run)
     if not log.exists():
+        if holder:
+            return RunStatus(IN_PROGRESS, None, f"the run is starting ({holder})")
         return RunStatus("cut off", None, f"{log} does not exist: no way to tell how the run "
                          "ended")
     lines = log.read_text(errors="replace").splitlines()
@@ -300,6 +310,8 @@ def run_status(run, last_dump_step: int | None = None) -> RunStatus:
             last_step = int(words[0])
     if errors:
         return RunStatus("error", last_step, f"the run failed: {errors[-1]}", errors[-1])
+    if holder and not any(line.startswith(FINISH_LINE) for line in lines):
+        return RunStatus(IN_PROGRESS, last_step, f"in progress at step {last_step} ({holder})")
     if header and (not loops or loops[-1] < header[-1]):
         return RunStatus("cut off", last_step, f"{log} ends inside a run at step {last_step}: "
                          "the run was cut off")
@@ -347,8 +359,13 @@ def read_outcome(directory) -> dict | None:
 
 
 def finished(directory) -> bool:
-    """Whether the run has its outcome (complete, or recorded as failed)."""
-    return (Path(directory) / OUTCOME).exists()
+    """Whether the run has its outcome (complete, or recorded as failed); the outcome of a
+    partial analysis (``jkrdt analyse --partial`` of a run cut off or in progress) is not
+    one."""
+    if not (Path(directory) / OUTCOME).exists():
+        return False
+    outcome = read_outcome(directory)
+    return outcome is None or outcome.get("stop_reason") not in ("cut off", IN_PROGRESS)
 
 
 def failed(directory) -> bool:
@@ -388,7 +405,29 @@ def claim(directory, even_finished: bool = False):
     f.truncate(0)
     f.write(f"{socket.gethostname()} pid {os.getpid()} since {time.ctime()}\n")
     f.flush()
+    _HELD[directory.resolve()] = f
     return f
+
+
+#: the claims this process holds, by directory: ``running`` must not probe those (a probe's
+#: close would release the process's lock)
+_HELD: dict = {}
+
+
+def running(directory) -> str | None:
+    """Who runs ``directory`` now (its claim's line: host, pid, since when), or None when
+    no other live process holds its claim (this process's own run is told by its log)."""
+    path = Path(directory) / CLAIM
+    mine = _HELD.get(Path(directory).resolve())
+    if (mine is not None and not mine.closed) or not path.exists():
+        return None
+    with open(path, "a+") as f:
+        try:
+            fcntl.lockf(f, fcntl.LOCK_SH | fcntl.LOCK_NB)
+        except OSError:
+            f.seek(0)
+            return f.read().strip() or "another process"
+    return None
 
 
 class RunHeld(RuntimeError):

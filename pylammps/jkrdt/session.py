@@ -124,18 +124,23 @@ class Session:
     def _keep_record(self, restart, append: bool, force: bool) -> None:
         """Refuse to start a new record over the one ``out`` holds: a finished run's (unless
         ``force``), or any run's when continuing from a restart file without ``append``."""
-        if append or force or not (self.out / rundir.LOG).exists():
-            return
-        status = rundir.run_status(self.out)
-        if restart is not None:
-            raise ValueError(f"{self.out} holds a run's record ({status.stop_reason}): "
-                             f"continuing from {restart} there would replace it; give "
-                             "append=True to add to it (cut back to the restart's step with "
-                             "jkrdt.rundir.cut_back), or another out")
-        if status.problem is None:
-            raise ValueError(f"{self.out} holds a finished run ({status.stop_reason} at step "
-                             f"{status.stop_step}); give another out, or force=True to replace "
-                             "its record")
+        refused = None
+        # rank 0 decides: it holds the claim, which the other ranks would see as a run
+        # in progress
+        if self.comm.rank == 0 and not (append or force) and (self.out / rundir.LOG).exists():
+            status = rundir.run_status(self.out)
+            if restart is not None:
+                refused = (f"{self.out} holds a run's record ({status.stop_reason}): "
+                           f"continuing from {restart} there would replace it; give "
+                           "append=True to add to it (cut back to the restart's step with "
+                           "jkrdt.rundir.cut_back), or another out")
+            elif status.problem is None:
+                refused = (f"{self.out} holds a finished run ({status.stop_reason} at step "
+                           f"{status.stop_step}); give another out, or force=True to replace "
+                           "its record")
+        refused = self.comm.bcast(refused, root=0)
+        if refused:
+            raise ValueError(refused)
 
     def _sample(self) -> None:
         """Append the energies of the current step (a collective call on all ranks)."""

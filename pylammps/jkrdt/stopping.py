@@ -44,7 +44,7 @@ COMPLETE = ("settled", "steps")
 #: how the summaries and jkrdt run say each stop reason
 STOP_WORDS = {"settled": "settled", "cap": "hit the cap before settling",
               "steps": "ran its fixed number of steps (no settle rule)",
-              "error": "FAILED", "cut off": "was CUT OFF"}
+              "error": "FAILED", "cut off": "was CUT OFF", "in progress": "is in progress"}
 
 
 #: what fix jkr/dt/settle's depart keyword takes
