@@ -287,7 +287,7 @@ def plot(summary: list[dict], path: Path) -> list[Path]:
 
 
 def markdown(study: dict) -> str:
-    """The README's tables from tradeoff.json (``--table``)."""
+    """The tables of docs/timestep.md from tradeoff.json (``--table``)."""
     names = dict(bcca2d="2D BCCA 64+64, 10 m/s", bpca3d_fric="3D BPCA 128+128, 20 m/s, frictional",
                  bpca3d_free="3D BPCA 128+128, 40 m/s, frictionless")
     lines = ["| scene | dt / t_c | steps to settle | s / collision | µs / atom-step | max \\|dE\\|/E_imp "
@@ -344,7 +344,7 @@ def main(argv=None) -> int:
     p.add_argument("--models-only", action="store_true",
                    help="only the cost of each model; merged into an existing tradeoff.json")
     p.add_argument("--table", action="store_true",
-                   help="print the README's tables from an existing tradeoff.json")
+                   help="print the tables of docs/timestep.md from an existing tradeoff.json")
     p.add_argument("--plot", action="store_true",
                    help="redraw tradeoff.png/pdf from an existing tradeoff.json")
     args = p.parse_args(argv)

@@ -359,7 +359,7 @@ inline void PairJKRDT::pair_loop(int ii_from, int ii_to, int eflag, bool tally_a
   // one another, instead of heading each pair's chain of dependent steps. 16 pairs: a
   // block's scratch (these arrays, the lanes' inputs, each contact's motion and result)
   // then stays in a 48 KB L1 cache between its passes; at 64 it did not, and the full
-  // model's loop missed L1 on about 6 writes per pair (callgrind, README "Speed")
+  // model's loop missed L1 on about 6 writes per pair (callgrind, docs/performance.md)
   constexpr int BLOCK = 16;
   struct {
     int i[BLOCK], j[BLOCK], slot[BLOCK];

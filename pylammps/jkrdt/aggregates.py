@@ -325,7 +325,7 @@ def fractal_fit(n: np.ndarray, rg_over_r: np.ndarray) -> tuple[float, float]:
 BUILDERS = {"bpca": bpca, "bcca": bcca}
 
 #: peak memory of building and setting up grains, per grain: jkrdt setup of 2 x 50000 BPCA
-#: grains peaked at 360 MB resident (README, "At the paper's size"), rounded up
+#: grains peaked at 360 MB resident (docs/paper_size.md), rounded up
 BYTES_PER_GRAIN = 4000
 
 

@@ -289,7 +289,7 @@ def run_held(out: Path, dt: float | None, steps: int | None, nproc: int, rule: S
           f"on {nproc} rank(s); max |dE| / E_imp = {error:.2e}; log, dumps and restarts in {out}")
     if error > ENERGY_WARN:
         print(f"jkrdt: WARNING: max |dE| / E_imp = {error:.2e} exceeds {ENERGY_WARN:g}: reduce "
-              "--dt (see 'Choosing the time step' in the README)", file=sys.stderr)
+              "--dt (see docs/timestep.md, 'Choosing the time step')", file=sys.stderr)
     if status.stop_reason == "cut off":
         raise SystemExit(f"jkrdt: the run in {out} did not finish ({status.problem}); "
                          "jkrdt run continues it")

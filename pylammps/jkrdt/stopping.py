@@ -16,7 +16,7 @@ A run that has not settled by ``cap_tc`` (simulated time, in t_c) stops there wi
 reason "cap".
 
 At each check, fragments that have left the collision for good depart (``depart``
-"yes"; the rule is in the plugin's ``fix_jkr_dt_settle_depart.cpp`` and the README's
+"yes"; the rule is in the plugin's ``fix_jkr_dt_settle_depart.cpp`` and the manual's
 "Fragments that fly apart"): they keep their velocities, spins and contacts but stop
 and meet nothing more, so the box, the neighbor bins and the cost per step stop growing
 with them. "no" lets every fragment fly; "shadow" lets them fly and logs, once per
