@@ -33,13 +33,6 @@ ELSEWHERE = {
     "srun jkrdt campaign spec.json /shared/runs/c --ranks-per-run 1": (
         "tests/test_campaign.py", "--ranks-per-run"),
     "jkrdt summarise /shared/runs/c": ("tests/test_campaign.py", "summarise"),
-    "./run validate vfra_size --paper-size --np 2": ("validation/vfra_size.py", "--paper-size"),
-    "./run validate paper_protocol --stage paper --questions b": (
-        "validation/paper_protocol.py", "--questions"),
-    "./run validate paper_protocol --stage paper --questions c": (
-        "validation/paper_protocol.py", "--questions"),
-    "./run validate paper_protocol --questions d": ("validation/paper_protocol.py",
-                                                    "--questions"),
 }
 #: the quoted commands run here, in this order, in a scratch directory holding inputs/
 HERE = [
@@ -93,8 +86,16 @@ def test_the_readme_is_a_manual_not_a_notebook():
 
 
 def test_every_quoted_command_is_run_somewhere():
+    """HERE runs here; ELSEWHERE names what runs it; './run validate NAME ...' runs
+    validation/NAME.py, whose quick variant tests/test_validation.py runs."""
     quoted = {c for page in PAGES for c in quoted_commands(page)}
-    unplaced = quoted - set(HERE) - set(ELSEWHERE)
+    studies = {c for c in quoted if c.startswith("./run validate ")}
+    quick = (ROOT / "tests" / "test_validation.py").read_text()
+    for command in studies:
+        name = command.split()[2]
+        assert (ROOT / "validation" / f"{name}.py").exists(), f"{command!r}: no such study"
+        assert f'"{name}"' in quick, f"{command!r}: test_validation.py runs no quick {name}"
+    unplaced = quoted - studies - set(HERE) - set(ELSEWHERE)
     assert not unplaced, f"quoted but run nowhere: {sorted(unplaced)}; add each to HERE or " \
                          "ELSEWHERE in tests/test_docs.py"
     for command, (path, word) in ELSEWHERE.items():
