@@ -315,9 +315,15 @@ def prepare(directory: Path, spec: dict, scene: Scene, aggregates: dict):
     return None
 
 
-def run_one(spec: dict, directory: Path, resume, comm) -> str | None:
+#: a campaign shows a run's settle checks at most this often (s): a line a minute for each
+#: long run, none for runs of seconds
+LINE_EVERY_S = 60.0
+
+
+def run_one(spec: dict, directory: Path, resume, comm, name: str | None = None) -> str | None:
     """Run one collision on ``comm``, from ``resume`` = (restart file, its step) if given;
-    returns None, or the LAMMPS error that ended it."""
+    returns None, or the LAMMPS error that ended it. ``name``: show its settle checks
+    (at most one a ``LINE_EVERY_S``), each line opening with it."""
     from .session import Session
 
     restart, start = resume if resume is not None else (None, 0)
@@ -331,7 +337,9 @@ def run_one(spec: dict, directory: Path, resume, comm) -> str | None:
             if spec["settle"] is None:
                 run.run(spec["steps"] - start, chunk=spec["every"], progress=False)
             else:
-                run.run_until_settled(progress=False)
+                run.run_until_settled(progress=False, lines=None if name is None else
+                                      dict(prefix=f"{name}: ", every_s=LINE_EVERY_S,
+                                           bar=False))
             run.finish()
     except Exception as err:            # a LAMMPS error: recorded, the campaign goes on
         return str(err).strip().splitlines()[0]
@@ -396,7 +404,10 @@ def run_campaign(spec_path, campaign, progress: bool = True, ranks_per_run: int 
         resume = prepare(directory, spec, scene_of(spec, v, b2, seed), aggregates) if leader \
             else None
         resume = group.bcast(resume)
-        failed = None if resume == "ended" else run_one(spec, directory, resume, group)
+        name = f"[ranks {world.rank}-{world.rank + group.size - 1}] v {v:g} B_off^2 {b2:g} " \
+               f"seed {seed}"
+        failed = None if resume == "ended" else run_one(spec, directory, resume, group,
+                                                        name if progress else None)
         if leader:
             said = finish(directory, failed)
             held.close()
@@ -404,8 +415,7 @@ def run_campaign(spec_path, campaign, progress: bool = True, ranks_per_run: int 
             how = ("" if resume is None else " (its run had ended; analysed)"
                    if resume == "ended" else f" (resumed at step {resume[1]})")
             if progress:
-                print(f"[ranks {world.rank}-{world.rank + group.size - 1}] v {v:g} B_off^2 "
-                      f"{b2:g} seed {seed}{how}: {said}, {time.time() - t0:.1f} s", flush=True)
+                print(f"{name}{how}: {said}, {time.time() - t0:.1f} s", flush=True)
         group.Barrier()
     group.Free()
     ran = world.allreduce(ran if leader else 0)

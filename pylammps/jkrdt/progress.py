@@ -11,6 +11,7 @@ under Slurm they are plain lines, flushed as they come."""
 from __future__ import annotations
 
 import sys
+import time
 from pathlib import Path
 
 from . import ledger, rundir
@@ -31,9 +32,14 @@ class CheckLines:
     from a restart file that were shown before."""
 
     def __init__(self, out: Path, t_c: float, E_imp: float, cap_step: int | None = None,
-                 start_step: int = 0, stream=None, bar: bool | None = None):
+                 start_step: int = 0, stream=None, bar: bool | None = None,
+                 prefix: str = "", every_s: float = 0.0):
         self.out, self.t_c, self.E_imp = Path(out), t_c, E_imp
         self.cap_step, self.start_step = cap_step, start_step
+        # a campaign's runs side by side: each line named, and at most one per every_s
+        # (the first after every_s: a run of seconds shows none)
+        self.prefix, self.every_s = prefix, every_s
+        self.last_shown = time.monotonic() if every_s > 0 else None
         self.stream = stream or sys.stdout
         self.seen = start_step if start_step > 0 else -1    # a new run shows its step 0
         self.first_step, self.first_wall = None, 0.0
@@ -81,12 +87,13 @@ class CheckLines:
             if wall is not None and wall < 0:      # a table of an older build: its clock
                 wall = None                        # started again at a resume
                 self.first_step, self.first_wall = int(row["step"]), row["wall"]
-            text = self.line(row, wall, error)
+            text = self.prefix + self.line(row, wall, error)
             if self.bar is not None:
                 self.bar.write(text)
                 self.bar.update(int(row["step"]) - self.seen)
-            else:
+            elif self.last_shown is None or time.monotonic() - self.last_shown >= self.every_s:
                 print(text, file=self.stream, flush=True)
+                self.last_shown = time.monotonic()
             self.seen = int(row["step"])
 
     def close(self) -> None:

@@ -146,10 +146,12 @@ class Session:
         """Append the energies of the current step (a collective call on all ranks)."""
         self._rows.append(ledger.sample(self.lmp))
 
-    def run(self, steps: int, chunk: int | None = None, progress: bool = True) -> dict:
+    def run(self, steps: int, chunk: int | None = None, progress: bool = True,
+            watch=None) -> dict:
         """Advance ``steps`` steps in chunks of ``chunk`` (default steps/100), sampling the
         energies after each; returns all samples so far as ``thermo()`` does. With a
-        settle rule the run ends early, at the check where the collision settled."""
+        settle rule the run ends early, at the check where the collision settled.
+        ``watch`` (a ``jkrdt.progress.CheckLines``, rank 0) is polled after each chunk."""
         if steps < 0:
             raise ValueError("steps must be >= 0")
         chunk = max(1, steps // 100) if chunk is None else int(chunk)
@@ -172,6 +174,8 @@ class Session:
             done += ran
             self._sample()
             bar.update(ran)
+            if watch is not None:
+                watch.poll()
             if ran == 0 or (self.settle is not None and self.settle_state() != "running"):
                 break
             # the settle rule ended the chunk for wider neighbor bins, which LAMMPS takes
@@ -193,14 +197,26 @@ class Session:
 
         return self.lmp.extract_fix("settle", LMP_STYLE_GLOBAL, LMP_TYPE_VECTOR, 7) == 1.0
 
-    def run_until_settled(self, progress: bool = True) -> dict:
+    def run_until_settled(self, progress: bool = True, lines: dict | None = None) -> dict:
         """Run until the collision has settled or the cap is reached, checking the settle
         rule given to the session; ``stop_reason`` is then 'settled' or 'cap'. Warns when
-        the energy error exceeds ``jkrdt.stopping.ENERGY_WARN``."""
+        the energy error exceeds ``jkrdt.stopping.ENERGY_WARN``. With ``progress`` (and
+        outputs, so that the settle rule writes its table), rank 0 shows a line per check
+        as ``jkrdt run`` does (``jkrdt.progress.CheckLines``; ``lines``: its options, such
+        as a campaign's prefix and rate), else a bar over the steps."""
         if self.settle is None:
             raise ValueError("this session has no settle rule: Session(..., settle=SettleRule())")
         done = int(self.lmp.get_thermo("step"))
-        self.run(max(0, self.cap - done), chunk=self.check, progress=progress)
+        watch = None
+        if (progress or lines is not None) and self.outputs and self.comm.rank == 0:
+            from .progress import CheckLines
+
+            watch = CheckLines(self.out, self.scene.scales.t_c, self.meta["E_imp"], self.cap,
+                               done, **(lines or {}))
+        self.run(max(0, self.cap - done), chunk=self.check,
+                 progress=progress and watch is None, watch=watch)
+        if watch is not None:
+            watch.close()
         state = self.settle_state()
         self.stop_reason = "cap" if state == "running" else state
         self.warn_energy()
