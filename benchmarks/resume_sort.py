@@ -9,6 +9,11 @@ same end: the largest difference of any grain's position, velocity or spin again
 uninterrupted run, with the deck's sort at the restart steps (its default) and with
 LAMMPS's every 1000 steps (the deck's default before issue 48).
 
+Part 3, what putting the atoms in ID order costs (the plugin's pass at a run's set-up and
+at each restart step, ``plugin/jkr_dt_order.h``): the 2 x 25000 scene run by ``jkrdt run
+--np 2`` for ``--order-tc`` t_c, the plugin's own log line (its wall time of the pass, on
+rank 0) against LAMMPS's loop time, in the same run.
+
 Part 2, the cost at 2 x 25000: the same kind of scene run side by side, one check interval
 (50 t_c) at a time in turns (A B A B, ``side_by_side.alternate``), sorting every 1000 steps
 against sorting at the checks (every 50 t_c, about 2000 steps); us per atom-step per chunk
@@ -16,6 +21,7 @@ and their ratio, with the load average.
 
     python benchmarks/resume_sort.py                 # both parts, a few minutes on 2 cores
     python benchmarks/resume_sort.py --part 2 --until-tc 500
+    python benchmarks/resume_sort.py --part 3                # about a minute
 
 Writes JSON (default benchmarks/resume/resume_sort.json).
 """
@@ -72,10 +78,28 @@ def exact(scene: Path, work: Path, every: int, chunks: int, ranks: int, **variab
                 bit_for_bit=all(np.array_equal(end, straight) for end in ends.values()))
 
 
+def order_cost(scene: Path, until_tc: float) -> dict:
+    """Part 3: the ordering pass's wall time against the loop's, in one run on 2 ranks."""
+    import re
+
+    load = os.getloadavg()[0]
+    subprocess.run([str(BIN / "jkrdt"), "run", str(scene), "--np", "2", "--cap",
+                    str(until_tc), "--quiet"], check=True, capture_output=True)
+    log = (scene / "log.lammps").read_text()
+    steps, seconds = re.search(r"atoms put in ID order at (\d+) steps in (\S+) s", log).groups()
+    loop = float(re.findall(r"Loop time of (\S+) on 2 procs", log)[-1])
+    meta = json.loads((scene / "collision.json").read_text())
+    return dict(n_total=meta["N_tar"] + meta["N_pro"], until_tc=until_tc, ranks=2,
+                order_steps=int(steps), order_seconds=float(seconds), loop_seconds=loop,
+                order_share_of_loop=float(seconds) / loop,
+                load_average=[load, os.getloadavg()[0]])
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--part", type=int, choices=(1, 2), default=None)
+    ap.add_argument("--part", type=int, choices=(1, 2, 3), default=None)
+    ap.add_argument("--order-tc", type=float, default=400.0, help="part 3's run, t_c")
     ap.add_argument("--n", type=int, default=50000, help="grains per aggregate, part 1")
     ap.add_argument("--every", type=int, default=200)
     ap.add_argument("--chunks", type=int, default=3)
@@ -109,6 +133,10 @@ def main(argv=None) -> None:
                                   mean_total=float(b.sum() / a.sum())),
                               series=ran["series"])
         print(json.dumps(result["cost"]["ratio_at_checks_over_1000"]), flush=True)
+    if args.part in (None, 3):
+        result["order"] = order_cost(scene_at(work / "order_scene", args.n_cost, 1 / 12),
+                                     args.order_tc)
+        print(json.dumps(result["order"]), flush=True)
     result["cpu_count"] = os.cpu_count()
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(result, indent=1) + "\n")

@@ -205,6 +205,12 @@ void FixJKRDTContacts::post_run()
 {
   to_rows();    // between runs the rows are the state
   if (writer.by) writer.on_run_end();
+  // what the bit-for-bit order cost this run (rank 0's wall time; benchmarks/resume_sort.py)
+  if (order_count > 0)
+    utils::logmesg(lmp, "jkr/dt: atoms put in ID order at {} steps in {:.3f} s\n", order_count,
+                   order_seconds);
+  order_seconds = 0.0;
+  order_count = 0;
 }
 
 /* ----------------------------------------------------------------------
@@ -250,8 +256,11 @@ void FixJKRDTContacts::pre_exchange()
   // have them (jkr_dt_order.h)
   const bool restart_step = output->restart_flag && update->ntimestep == output->next_restart;
   if (update->setupflag || restart_step) {
+    const double t0 = MPI_Wtime();
     JKRDT::migrate_now(lmp);
     JKRDT::order_by_id(lmp);
+    order_seconds += MPI_Wtime() - t0;
+    ++order_count;
   }
   if (writer.by) writer.on_exchange();
 }

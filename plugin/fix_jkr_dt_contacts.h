@@ -173,6 +173,8 @@ class FixJKRDTContacts : public Fix {
   bool rows_stale;                  // the slots hold state the rows do not
   int slot_nlocal;                  // owned atoms when the slots were filled ...
   std::vector<tagint> slot_tag;     // ... and the IDs of all atoms then, owned and ghost
+  double order_seconds = 0.0;       // this run's wall time putting atoms in ID order ...
+  int order_count = 0;              // ... at this many steps (reported at its end)
 };
 
 }    // namespace LAMMPS_NS

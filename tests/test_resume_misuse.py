@@ -129,3 +129,71 @@ def _decompressed(path: Path) -> str:
     """The text of a compressed stream that may lack its end."""
     d = zlib.decompressobj(wbits=31)
     return d.decompress(path.read_bytes()).decode()
+
+
+#: 2 x 2500 at 20 m/s with a frame at every check (2 t_c), 40 t_c in all
+KILL_SCENE = ["--n-tar", "2500", "--n-pro", "2500", "--v", "20"]
+KILL_RUN = ["--check", "2", "--frames", "1", "--cap", "40", "--quiet"]
+
+
+def test_a_run_killed_while_gzip_writes_a_frame_resumes_as_the_run(tmp_path):
+    """A real SIGKILL to LAMMPS while it writes a compressed atom frame (the file seen
+    growing), then jkrdt run: the dumps, the table and the outcome are the uninterrupted
+    run's, bit for bit."""
+    import gzip
+    import shutil
+    import signal
+    import time
+
+    straight, cut = tmp_path / "straight", tmp_path / "cut"
+    subprocess.run([JKRDT, "setup", *KILL_SCENE, "--out", str(straight)], check=True,
+                   capture_output=True, timeout=300)
+    shutil.copytree(straight, cut)
+    subprocess.run([JKRDT, "run", str(straight), *KILL_RUN], check=True, capture_output=True,
+                   timeout=600)
+    going = subprocess.Popen([JKRDT, "run", str(cut), *KILL_RUN], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE)
+    deck = str(cut / rundir.DECK)
+    lammps, deadline = [], time.time() + 120
+    while not lammps and time.time() < deadline:
+        found = subprocess.run(["pgrep", "-f", f"lmp -in {deck}"], capture_output=True,
+                               text=True).stdout.split()
+        lammps = [int(p) for p in found]
+    assert lammps, "LAMMPS never started"
+    atoms = cut / rundir.ATOMS
+    checks = cut / rundir.CHECKS
+    while not checks.exists() or len(read_csv(checks)) < 6:      # a few frames first
+        assert going.poll() is None and time.time() < deadline, "the run ended too soon"
+        time.sleep(0.01)
+    size = atoms.stat().st_size
+    while atoms.stat().st_size == size:              # the next frame starts being written
+        assert going.poll() is None and time.time() < deadline, "no frame came"
+    # LAMMPS runs in a process group of its own (jkrdt run's): the whole group at once,
+    # as a lost node would
+    for group in {os.getpgid(pid) for pid in lammps}:
+        os.killpg(group, signal.SIGKILL)
+    going.kill()
+    going.wait(timeout=60)
+    time.sleep(0.5)
+    # the kill landed inside the frame: the stream is cut off
+    with pytest.raises(rundir.BROKEN_STREAM):
+        with gzip.open(atoms, "rt") as f:
+            f.read()
+    again = subprocess.run([JKRDT, "run", str(cut), *KILL_RUN], capture_output=True, text=True,
+                           timeout=600)
+    assert again.returncode == 0, again.stderr
+    for name in (rundir.ATOMS, rundir.CONTACTS):       # every member of each stream
+        texts = [gzip.decompress((d / name).read_bytes()) for d in (straight, cut)]
+        assert texts[1] == texts[0], name
+    timing = ("wall", "memory_mb", "peak_rss_mb")
+    tables = [[{k: v for k, v in r.items() if k not in timing} for r in read_csv(d / rundir.CHECKS)]
+              for d in (straight, cut)]
+    assert tables[1] == tables[0]
+    outcomes = []
+    for d in (straight, cut):
+        subprocess.run([JKRDT, "analyse", str(d), "--no-plots"], check=True,
+                       capture_output=True, timeout=300)
+        outcomes.append(json.loads((d / rundir.OUTCOME).read_text()))
+    for key in ("stop_reason", "stop_step", "n_largest", "n_fragments", "gyration_radius_largest",
+                "dissipated_fraction", "energy_error", "N_con", "N_cut", "N_cum"):
+        assert outcomes[1][key] == outcomes[0][key], key
