@@ -99,42 +99,69 @@ bool never_meet(const double p[3], const double q[3], double reach, double u)
 
 }    // namespace
 
+// what a check knows of its fragments, step by step
+struct SettleDeparture::Census {
+  int M = 0;                             // fragments with contacts (union-find roots)
+  std::vector<int> body_of_node;         // per graph node: its fragment
+  std::vector<int> body;                 // per owned grain: its fragment, or -1 (single)
+  std::vector<double> xu;                // per owned grain: its unwrapped position
+  std::vector<double> single;            // this rank's single grains: ID, m, x, v, r, departed
+  std::vector<Body> B;                   // the fragments with contacts, then single grains
+  std::vector<double> internal_speed2;   // per owned grain: |v - rigid motion|^2
+  std::vector<int> first_grain;          // the hot grains of fragment b: first_grain[b] ...
+  std::vector<double> grains;            // ... of x, v, r (7 values each), every rank's
+  double rmax = 0.0;                     // the largest grain radius, every rank's
+};
+
 bool SettleDeparture::find(FragmentGraph &graph, const int *npartner, double now)
 {
+  Census c;
+  number_bodies(c, graph);
+  sum_motion(c, graph);
+  fit_spin_and_reach(c);
+  gather_hot_grains(c, npartner);
+  add_single_grains(c);
+  return depart(c, who_leaves(c), now);
+}
+
+// fragments with contacts: the union-find roots, numbered in node order
+void SettleDeparture::number_bodies(Census &c, FragmentGraph &graph) const
+{
   const int nlocal = atom->nlocal;
-  int *mask = atom->mask;
+  const tagint *tag = atom->tag;
+  c.body_of_node.assign(graph.parent.size(), -1);
+  for (int k = 0; k < (int) graph.parent.size(); k++) {
+    const int r = graph.root(k);
+    if (c.body_of_node[r] < 0) c.body_of_node[r] = c.M++;
+    c.body_of_node[k] = c.body_of_node[r];
+  }
+  c.body.assign(nlocal, -1);
+  c.xu.resize(3 * (size_t) nlocal);
+  for (int i = 0; i < nlocal; i++) {
+    auto it = graph.index.find(tag[i]);
+    if (it != graph.index.end()) c.body[i] = c.body_of_node[it->second];
+    domain->unmap(atom->x[i], atom->image[i], &c.xu[3 * i]);
+  }
+}
+
+// pass 1: mass, centre of mass, velocity, departed grains; smallest ID
+void SettleDeparture::sum_motion(Census &c, const FragmentGraph &graph) const
+{
+  const int nlocal = atom->nlocal, M = c.M;
+  const int *mask = atom->mask;
   const tagint *tag = atom->tag;
   const double *rmass = atom->rmass, *radius = atom->radius;
   double **v = atom->v;
-
-  // fragments with contacts: the union-find roots, numbered in node order
-  std::vector<int> body_of_node(graph.parent.size(), -1);
-  int M = 0;
-  for (int k = 0; k < (int) graph.parent.size(); k++) {
-    const int r = graph.root(k);
-    if (body_of_node[r] < 0) body_of_node[r] = M++;
-    body_of_node[k] = body_of_node[r];
-  }
-  std::vector<int> body(nlocal, -1);
-  std::vector<double> xu(3 * (size_t) nlocal);
-  for (int i = 0; i < nlocal; i++) {
-    auto it = graph.index.find(tag[i]);
-    if (it != graph.index.end()) body[i] = body_of_node[it->second];
-    domain->unmap(atom->x[i], atom->image[i], &xu[3 * i]);
-  }
-
-  // pass 1: mass, centre of mass, velocity, departed grains; smallest ID
   std::vector<double> sum(8 * (size_t) M, 0.0), all(8 * (size_t) M);
   std::vector<tagint> label(M, MAXTAGINT), label_all(M);
   // single grains travel to every rank whole: ID, m, x, v, r, departed
-  std::vector<double> single;
   for (int i = 0; i < nlocal; i++) {
     const double m = rmass[i];
-    const double *x = &xu[3 * i];
-    const int b = body[i];
+    const double *x = &c.xu[3 * i];
+    const int b = c.body[i];
     if (b < 0) {
-      single.insert(single.end(), {(double) tag[i], m, x[0], x[1], x[2], v[i][0], v[i][1],
-                                   v[i][2], radius[i], (mask[i] & departed_bit) ? 1.0 : 0.0});
+      c.single.insert(c.single.end(), {(double) tag[i], m, x[0], x[1], x[2], v[i][0], v[i][1],
+                                       v[i][2], radius[i], (mask[i] & departed_bit) ? 1.0 : 0.0});
       continue;
     }
     double *s = &sum[8 * b];
@@ -149,25 +176,35 @@ bool SettleDeparture::find(FragmentGraph &graph, const int *npartner, double now
   MPI_Allreduce(sum.data(), all.data(), 8 * M, MPI_DOUBLE, MPI_SUM, world);
   MPI_Allreduce(label.data(), label_all.data(), M, MPI_LMP_TAGINT, MPI_MIN, world);
 
-  std::vector<Body> B(M);
+  c.B.assign(M, Body());
   std::vector<int> node_count(M, 0);
-  for (int k = 0; k < (int) graph.parent.size(); k++) node_count[body_of_node[k]]++;
+  for (int k = 0; k < (int) graph.parent.size(); k++) node_count[c.body_of_node[k]]++;
   for (int b = 0; b < M; b++) {
     const double *s = &all[8 * b];
-    B[b].m = s[0];
+    Body &B = c.B[b];
+    B.m = s[0];
     for (int k = 0; k < 3; k++) {
-      B[b].c[k] = s[1 + k] / s[0];
-      B[b].V[k] = s[4 + k] / s[0];
+      B.c[k] = s[1 + k] / s[0];
+      B.V[k] = s[4 + k] / s[0];
     }
-    B[b].departed = s[7] > 0.0;
-    B[b].label = label_all[b];
-    B[b].n = node_count[b];
+    B.departed = s[7] > 0.0;
+    B.label = label_all[b];
+    B.n = node_count[b];
   }
+}
 
-  // pass 2: inertia tensor and angular momentum about the centre of mass
+// pass 2: inertia tensor and angular momentum about the centre of mass, the spin;
+// pass 3: bounding radius and internal speed
+void SettleDeparture::fit_spin_and_reach(Census &c) const
+{
+  const int nlocal = atom->nlocal, M = c.M;
+  const double *rmass = atom->rmass, *radius = atom->radius;
+  double **v = atom->v;
+  const std::vector<double> &xu = c.xu;
+  std::vector<Body> &B = c.B;
   std::vector<double> rot(9 * (size_t) M, 0.0), rot_all(9 * (size_t) M);
   for (int i = 0; i < nlocal; i++) {
-    const int b = body[i];
+    const int b = c.body[i];
     if (b < 0) continue;
     const double m = rmass[i];
     const double r[3] = {xu[3 * i] - B[b].c[0], xu[3 * i + 1] - B[b].c[1],
@@ -188,11 +225,10 @@ bool SettleDeparture::find(FragmentGraph &graph, const int *npartner, double now
   std::vector<double> omega(3 * (size_t) M);
   for (int b = 0; b < M; b++) fit_rotation(&rot_all[9 * b], &rot_all[9 * b + 6], &omega[3 * b]);
 
-  // pass 3: bounding radius and internal speed
   std::vector<double> ext(2 * (size_t) M, 0.0), ext_all(2 * (size_t) M);
-  std::vector<double> internal_speed2(nlocal, 0.0);
+  c.internal_speed2.assign(nlocal, 0.0);
   for (int i = 0; i < nlocal; i++) {
-    const int b = body[i];
+    const int b = c.body[i];
     if (b < 0) continue;
     const double *w = &omega[3 * b];
     const double r[3] = {xu[3 * i] - B[b].c[0], xu[3 * i + 1] - B[b].c[1],
@@ -207,44 +243,50 @@ bool SettleDeparture::find(FragmentGraph &graph, const int *npartner, double now
     const double reach = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]) + radius[i];
     ext[2 * b] = std::max(ext[2 * b], reach);
     ext[2 * b + 1] = std::max(ext[2 * b + 1], std::sqrt(u2));
-    internal_speed2[i] = u2;
+    c.internal_speed2[i] = u2;
   }
   MPI_Allreduce(ext.data(), ext_all.data(), 2 * M, MPI_DOUBLE, MPI_MAX, world);
   for (int b = 0; b < M; b++) {
     B[b].R = ext_all[2 * b];
     B[b].u = ext_all[2 * b + 1];
   }
+}
 
-  // the grains of fragments with contacts that have the energy to break free, every
-  // rank's, grouped by fragment: x, v, r. A grain whose kinetic energy against its
-  // fragment's rigid motion is below E_break per contact it holds cannot break them
-  // all: it stays bound, inside its fragment's sphere
+// the grains of fragments with contacts that have the energy to break free, every
+// rank's, grouped by fragment: x, v, r. A grain whose kinetic energy against its
+// fragment's rigid motion is below E_break per contact it holds cannot break them
+// all: it stays bound, inside its fragment's sphere
+void SettleDeparture::gather_hot_grains(Census &c, const int *npartner) const
+{
+  const int nlocal = atom->nlocal, M = c.M;
+  const double *rmass = atom->rmass, *radius = atom->radius;
+  double **v = atom->v;
   std::vector<double> mine_grains;
   for (int i = 0; i < nlocal; i++) {
-    const int b = body[i];
-    if (b < 0 || B[b].departed) continue;
-    if (0.5 * rmass[i] * internal_speed2[i] <= npartner[i] * break_energy) continue;
-    const double *x = &xu[3 * i];
+    const int b = c.body[i];
+    if (b < 0 || c.B[b].departed) continue;
+    if (0.5 * rmass[i] * c.internal_speed2[i] <= npartner[i] * break_energy) continue;
+    const double *x = &c.xu[3 * i];
     mine_grains.insert(mine_grains.end(),
                        {(double) b, x[0], x[1], x[2], v[i][0], v[i][1], v[i][2], radius[i]});
   }
   const std::vector<double> grains_raw = FixJKRDTContacts::gather(mine_grains, world);
-  std::vector<int> first_grain(M + 1, 0);
-  for (size_t k = 0; k < grains_raw.size(); k += 8) first_grain[(int) grains_raw[k] + 1]++;
-  for (int b = 0; b < M; b++) first_grain[b + 1] += first_grain[b];
-  std::vector<double> grains(grains_raw.size() / 8 * 7);
-  {
-    std::vector<int> fill(first_grain.begin(), first_grain.end() - 1);
-    for (size_t k = 0; k < grains_raw.size(); k += 8)
-      std::copy(&grains_raw[k + 1], &grains_raw[k + 8], &grains[7 * fill[(int) grains_raw[k]]++]);
-  }
+  c.first_grain.assign(M + 1, 0);
+  for (size_t k = 0; k < grains_raw.size(); k += 8) c.first_grain[(int) grains_raw[k] + 1]++;
+  for (int b = 0; b < M; b++) c.first_grain[b + 1] += c.first_grain[b];
+  c.grains.resize(grains_raw.size() / 8 * 7);
+  std::vector<int> fill(c.first_grain.begin(), c.first_grain.end() - 1);
+  for (size_t k = 0; k < grains_raw.size(); k += 8)
+    std::copy(&grains_raw[k + 1], &grains_raw[k + 8], &c.grains[7 * fill[(int) grains_raw[k]]++]);
+}
 
-  // single grains of every rank, in rank order
-  const std::vector<double> singles = FixJKRDTContacts::gather(single, world);
+// single grains of every rank, in rank order, as bodies after the fragments
+void SettleDeparture::add_single_grains(Census &c) const
+{
+  const std::vector<double> singles = FixJKRDTContacts::gather(c.single, world);
   double rmax = 0.0;
-  for (int i = 0; i < nlocal; i++) rmax = std::max(rmax, radius[i]);
-  double rmax_all;
-  MPI_Allreduce(&rmax, &rmax_all, 1, MPI_DOUBLE, MPI_MAX, world);
+  for (int i = 0; i < atom->nlocal; i++) rmax = std::max(rmax, atom->radius[i]);
+  MPI_Allreduce(&rmax, &c.rmax, 1, MPI_DOUBLE, MPI_MAX, world);
   for (size_t k = 0; k < singles.size(); k += 10) {
     Body s;
     s.label = static_cast<tagint>(singles[k]);
@@ -256,11 +298,16 @@ bool SettleDeparture::find(FragmentGraph &graph, const int *npartner, double now
     s.R = singles[k + 8];
     s.departed = singles[k + 9] > 0.0;
     s.n = 1;
-    B.push_back(s);
+    c.B.push_back(s);
   }
+}
 
-  // the largest fragment stays; the others are tested, candidates shared out over ranks
-  const int F = static_cast<int>(B.size());
+// per body, 1 if it leaves: the largest fragment stays; the others are tested,
+// candidates shared out over ranks
+std::vector<int> SettleDeparture::who_leaves(const Census &c) const
+{
+  const std::vector<Body> &B = c.B;
+  const int F = static_cast<int>(B.size()), M = c.M;
   int largest = -1;
   for (int b = 0; b < F; b++)
     if (largest < 0 || B[b].n > B[largest].n ||
@@ -269,14 +316,13 @@ bool SettleDeparture::find(FragmentGraph &graph, const int *npartner, double now
   std::vector<int> active;
   for (int b = 0; b < F; b++)
     if (!B[b].departed) active.push_back(b);
-  const double margin = 2.0 * rmax_all;
-  std::vector<int> leaves(F, 0), leaves_all(F, 0), hot_buffer;
+  const double margin = 2.0 * c.rmax;
+  std::vector<int> leaves(F, 0), leaves_all(F, 0), hot;
   for (size_t a = comm->me; a < active.size(); a += comm->nprocs) {
     const Body &J = B[active[a]];
     if (active[a] == largest || !(J.u < quiet_speed)) continue;
     // the spheres first, for all (cheap); the grains of hot fragments only if they pass
     bool free = true;
-    std::vector<int> &hot = hot_buffer;
     hot.clear();
     for (const int i : active) {
       if (i == active[a]) continue;
@@ -296,8 +342,8 @@ bool SettleDeparture::find(FragmentGraph &graph, const int *npartner, double now
     }
     for (size_t h = 0; free && h < hot.size(); h++) {
       const int i = hot[h];
-      for (int g = first_grain[i]; free && g < first_grain[i + 1]; g++) {
-        const double *G = &grains[7 * g];
+      for (int g = c.first_grain[i]; free && g < c.first_grain[i + 1]; g++) {
+        const double *G = &c.grains[7 * g];
         const double pg[3] = {G[0] - J.c[0], G[1] - J.c[1], G[2] - J.c[2]};
         const double qg[3] = {G[3] - J.V[0], G[4] - J.V[1], G[5] - J.V[2]};
         free = never_meet(pg, qg, G[6] + J.R + margin, J.u);
@@ -306,8 +352,17 @@ bool SettleDeparture::find(FragmentGraph &graph, const int *npartner, double now
     if (free) leaves[active[a]] = 1;
   }
   MPI_Allreduce(leaves.data(), leaves_all.data(), F, MPI_INT, MPI_MAX, world);
+  return leaves_all;
+}
 
-  // counts, the log, and for depart yes the grains' groups
+// counts, the log, and for depart yes the grains' groups
+bool SettleDeparture::depart(const Census &c, const std::vector<int> &leaves_all, double now)
+{
+  const std::vector<Body> &B = c.B;
+  const int F = static_cast<int>(B.size()), M = c.M;
+  const int nlocal = atom->nlocal;
+  int *mask = atom->mask;
+  const tagint *tag = atom->tag;
   bigint n_frag = 0, n_grains = 0;
   double gone_grains = 0.0, gone_frags = 0.0;
   for (int b = 0; b < F; b++) {
@@ -336,7 +391,8 @@ bool SettleDeparture::find(FragmentGraph &graph, const int *npartner, double now
   const int slot = atom->find_custom(DEPARTED_AT, flag, cols);
   double *departed_at = (slot >= 0 && flag == 1 && cols == 0) ? atom->dvector[slot] : nullptr;
   for (int i = 0; i < nlocal; i++) {
-    const bool go = body[i] >= 0 ? leaves_all[body[i]] != 0 : single_leaves.count(tag[i]) > 0;
+    const bool go =
+        c.body[i] >= 0 ? leaves_all[c.body[i]] != 0 : single_leaves.count(tag[i]) > 0;
     if (!go) continue;
     mask[i] |= departed_bit;
     mask[i] &= ~moving_bits;

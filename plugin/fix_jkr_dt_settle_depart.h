@@ -11,6 +11,7 @@
 #include "jkr_dt_fragments.h"
 
 #include <unordered_set>
+#include <vector>
 
 namespace LAMMPS_NS {
 
@@ -36,6 +37,16 @@ class SettleDeparture : protected Pointers {
 
  private:
   std::unordered_set<tagint> shadowed;    // fragments reported by depart shadow
+
+  // find() in its steps, each over what the check knows so far (a Census)
+  struct Census;
+  void number_bodies(Census &c, FragmentGraph &graph) const;
+  void sum_motion(Census &c, const FragmentGraph &graph) const;
+  void fit_spin_and_reach(Census &c) const;
+  void gather_hot_grains(Census &c, const int *npartner) const;
+  void add_single_grains(Census &c) const;
+  std::vector<int> who_leaves(const Census &c) const;
+  bool depart(const Census &c, const std::vector<int> &leaves, double now);
 };
 
 }    // namespace LAMMPS_NS

@@ -1,0 +1,79 @@
+"""The plugin keeps its layers, and no function grows past what one reads at once
+(issue 49): a header includes only headers of lower layers (the kernel knows no
+LAMMPS), and a function in plugin/, pylammps/ or analysis/ is at most MAX_LINES long,
+but for those still to be split, which may not grow."""
+
+import ast
+import re
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+PLUGIN = ROOT / "plugin"
+
+#: the plugin's headers by layer: 0 the contact kernel (the papers' equations, no
+#: LAMMPS), 1 helpers on LAMMPS types, 2 the contact store and the settle rule's parts,
+#: 3 the styles a deck names
+LAYERS = {
+    "jkr_dt_normal.h": 0, "jkr_dt_tangential.h": 0, "jkr_dt_contact.h": 0,
+    "jkr_dt_lanes.h": 0, "jkr_dt_arena.h": 0,
+    "jkr_dt_fragments.h": 1, "jkr_dt_order.h": 1,
+    "fix_jkr_dt_contacts.h": 2, "fix_jkr_dt_settle_depart.h": 2,
+    "fix_jkr_dt_settle_table.h": 2,
+    "pair_jkr_dt.h": 3, "fix_jkr_dt_settle.h": 3, "compute_jkr_dt.h": 3,
+}
+MAX_LINES = 120
+#: the functions still longer, with the length they may not pass (issue 49, item 1)
+TO_SPLIT = {"plugin/pair_jkr_dt_loop.cpp:pair_loop": 493}
+
+
+def included(header: Path) -> list[str]:
+    return re.findall(r'^#include "([^"]+)"', header.read_text(), re.M)
+
+
+def test_every_header_has_a_layer():
+    headers = {p.name for p in PLUGIN.glob("*.h")}
+    assert headers == set(LAYERS), f"place these in LAYERS: {sorted(headers ^ set(LAYERS))}"
+
+
+def test_a_header_includes_only_lower_layers():
+    for name, layer in LAYERS.items():
+        for inc in included(PLUGIN / name):
+            if inc in LAYERS:
+                # the kernel's headers build on each other; above it, strictly downwards
+                ok = LAYERS[inc] < layer or (layer == 0 and LAYERS[inc] == 0)
+                assert ok, f"{name} (layer {layer}) includes {inc} (layer {LAYERS[inc]})"
+            else:                          # a LAMMPS header: not in the kernel
+                assert layer > 0, f"the kernel header {name} includes LAMMPS's {inc}"
+
+
+def function_lengths() -> dict[str, int]:
+    """name -> lines, for Python functions (ast) and C++ functions whose body opens with
+    a '{' alone at the start of a line (the plugin's style)."""
+    lengths = {}
+    for path in [*(ROOT / "pylammps").rglob("*.py"), *(ROOT / "analysis").glob("*.py")]:
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                key = f"{path.relative_to(ROOT)}:{node.name}"
+                lengths[key] = max(lengths.get(key, 0), node.end_lineno - node.lineno + 1)
+    for path in [*PLUGIN.glob("*.cpp"), *PLUGIN.glob("*.h")]:
+        lines = path.read_text().splitlines()
+        k = 1
+        while k < len(lines):
+            if lines[k] == "{":
+                end = next(j for j in range(k + 1, len(lines)) if lines[j] == "}")
+                head = " ".join(lines[max(0, k - 3):k])
+                names = re.findall(r"([A-Za-z_][A-Za-z_0-9]*)\s*\(", head)
+                key = f"{path.relative_to(ROOT)}:{names[0] if names else head.strip()}"
+                lengths[key] = max(lengths.get(key, 0), end - k + 2)
+                k = end
+            k += 1
+    return lengths
+
+
+def test_no_function_passes_max_lines():
+    lengths = function_lengths()
+    too_long = {k: n for k, n in lengths.items() if n > MAX_LINES and k not in TO_SPLIT}
+    assert not too_long, f"split these by job (at most {MAX_LINES} lines): {too_long}"
+    for key, ceiling in TO_SPLIT.items():
+        assert key in lengths, f"{key} is gone: drop it from TO_SPLIT"
+        assert lengths[key] <= ceiling, f"{key} grew to {lengths[key]} lines"
