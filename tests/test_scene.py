@@ -82,7 +82,7 @@ def test_the_set_ups_open_choices_place_bonds_and_gap_as_asked(tmp_path):
         Scene(ICE, 8, 8, v_col=1.0, gap=-1e-9)
 
 
-def test_committed_scene_decks_are_what_the_scene_module_writes(tmp_path):
+def test_committed_scene_decks_are_what_rundir_writes(tmp_path):
     for name in ("bcca_2d_head_on", "bpca_3d_oblique"):
         committed = ROOT / "inputs" / "data" / name
         copy = tmp_path / name

@@ -216,7 +216,7 @@ def write_deck(directory, scene: Scene | None = None) -> Path:
     (a variable's first definition wins, so ``-var NAME VALUE`` still overrides)."""
     directory = Path(directory)
     scene = read(directory) if scene is None else scene
-    lines = ["# jkr/dt: the scene in this directory (written by jkr/dt's scene module); run",
+    lines = ["# jkr/dt: the scene in this directory (written by jkrdt.rundir.write_deck); run",
              "#   lmp -in in.collision.lmp     or     mpirun -np 2 lmp -in in.collision.lmp",
              "# here. Any variable below can be overridden with -var NAME VALUE.", ""]
     lines += [f'variable {name:<10} index "{value}"'
