@@ -11,8 +11,8 @@ LAMMPS's every 1000 steps (the deck's default before issue 48).
 
 Part 3, what putting the atoms in ID order costs (the plugin's pass at a run's set-up and
 at each restart step, ``plugin/jkr_dt_order.h``): the 2 x 25000 scene run by ``jkrdt run
---np 2`` for ``--order-tc`` t_c, the plugin's own log line (its wall time of the pass, on
-rank 0) against LAMMPS's loop time, in the same run.
+--np 2`` for ``--order-tc`` t_c, the deck's closing line (the contact store's count of
+the passes and their wall time on rank 0) against LAMMPS's loop time, in the same run.
 
 Part 2, the cost at 2 x 25000: the same kind of scene run side by side, one check interval
 (50 t_c) at a time in turns (A B A B, ``side_by_side.alternate``), sorting every 1000 steps

@@ -50,6 +50,9 @@ FixJKRDTContacts::FixJKRDTContacts(LAMMPS *lmp, int narg, char **arg) :
   scalar_flag = 1;
   global_freq = 1;
   extscalar = 0;
+  vector_flag = 1;    // what putting atoms in ID order has cost: passes, seconds (rank 0)
+  size_vector = 2;
+  extvector = 0;
 
   // an atom's exchange record grows with its contacts: Comm and Irregular size their
   // buffers from maxexchange, which set_exchange_size() keeps at the largest record
@@ -205,12 +208,6 @@ void FixJKRDTContacts::post_run()
 {
   to_rows();    // between runs the rows are the state
   if (writer.by) writer.on_run_end();
-  // what the bit-for-bit order cost this run (rank 0's wall time; benchmarks/resume_sort.py)
-  if (order_count > 0)
-    utils::logmesg(lmp, "jkr/dt: atoms put in ID order at {} steps in {:.3f} s\n", order_count,
-                   order_seconds);
-  order_seconds = 0.0;
-  order_count = 0;
 }
 
 /* ----------------------------------------------------------------------

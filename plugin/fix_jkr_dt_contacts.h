@@ -101,6 +101,8 @@ class FixJKRDTContacts : public Fix {
   static std::vector<double> gather(const std::vector<double> &mine, MPI_Comm world);
   void post_run() override;
   double compute_scalar() override { return dnum; }    // doubles stored per contact
+  // the passes that put the atoms in ID order so far, and their wall time on this rank (s)
+  double compute_vector(int i) override { return i == 0 ? order_count : order_seconds; }
 
   // the fields stored per contact (a mask of the kernel's StateFields, jkr_dt_contact.h)
   void set_layout(int mask);
@@ -173,8 +175,8 @@ class FixJKRDTContacts : public Fix {
   bool rows_stale;                  // the slots hold state the rows do not
   int slot_nlocal;                  // owned atoms when the slots were filled ...
   std::vector<tagint> slot_tag;     // ... and the IDs of all atoms then, owned and ghost
-  double order_seconds = 0.0;       // this run's wall time putting atoms in ID order ...
-  int order_count = 0;              // ... at this many steps (reported at its end)
+  double order_seconds = 0.0;       // wall time putting atoms in ID order ...
+  int order_count = 0;              // ... at this many steps (compute_vector; the deck's end)
 };
 
 }    // namespace LAMMPS_NS
