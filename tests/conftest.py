@@ -7,6 +7,10 @@ from jkrdt.materials import ICE, scales
 from jkrdt.session import start_lammps
 
 R_GRAIN = 1.0e-7          # 0.1 micron grains, as in both papers
+#: the environment of runs with more ranks than cores: MPICH's ranks sleep while they wait
+#: instead of polling (4 polling ranks on 2 cores take several times as long)
+SLEEPING_RANKS = dict(MPIR_CVAR_CH4_PROGRESS_THROTTLE="true",
+                      MPIR_CVAR_CH4_PROGRESS_THROTTLE_NO_PROGRESS_COUNT="1")
 ICE_SCALES = scales(ICE, R_GRAIN)
 
 

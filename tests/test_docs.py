@@ -8,7 +8,6 @@ import subprocess
 import sys
 from pathlib import Path
 
-import pytest
 
 from jkrdt import rundir
 from jkrdt.campaign import read_spec

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from conftest import SLEEPING_RANKS
 from jkrdt import rundir
 
 from jkrdt import scene as scene_module
@@ -53,9 +54,10 @@ def run_deck(workdir, data, model, nproc=1, steps=STEPS, restart=None, extra=(),
         cmd += ["-var", "read", "read_restart"]
     if nproc > 1:
         cmd = [str(BIN / "mpirun"), "-np", str(nproc)] + cmd
-    # threads that sleep while they wait: more threads than cores (2 ranks x 2 threads on
-    # 2 cores) would otherwise spin against each other
-    env = dict(os.environ, OMP_NUM_THREADS=str(threads), OMP_WAIT_POLICY="PASSIVE")
+    # threads and ranks that sleep while they wait: more of them than cores (2 ranks x 2
+    # threads, or 4 ranks, on 2 cores) would otherwise spin against each other
+    env = dict(os.environ, OMP_NUM_THREADS=str(threads), OMP_WAIT_POLICY="PASSIVE",
+               **SLEEPING_RANKS)
     subprocess.run(cmd, check=True, cwd=workdir, timeout=600, env=env)
     final = np.loadtxt(workdir / rundir.FINAL_DUMP, skiprows=9)
     return final[np.argsort(final[:, 0])]
@@ -233,7 +235,7 @@ def test_load_balancing_keeps_every_contact(serial, scene, model, tmp_path, npro
            "-var", "coeffs", scene_module.pair_coeff(ICE, model),
            "-var", "dt", repr(0.014 * S.t_c), "-var", "every", "500", "-var", "outputs", "no"]
     subprocess.run(cmd, check=True, cwd=tmp_path, timeout=600,
-                   env=dict(os.environ, OMP_NUM_THREADS="1"))
+                   env=dict(os.environ, OMP_NUM_THREADS="1", **SLEEPING_RANKS))
     final = np.loadtxt(tmp_path / "final.dump", skiprows=9)
     dx, dv = scale_error(serial, final[np.argsort(final[:, 0])])
     log = (tmp_path / "log.lammps").read_text()

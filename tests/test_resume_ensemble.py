@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from conftest import SLEEPING_RANKS
 from jkrdt import rundir
 from jkrdt.analysis.outcome import growth_efficiency
 from jkrdt.analysis.tables import read_csv
@@ -40,8 +41,7 @@ def run(scene: Path, out: Path, steps: int, ranks: int = 1, threads: int = 1, **
         cmd = [str(BIN / "mpirun"), "-np", str(ranks)] + cmd
     # threads and ranks that sleep while they wait (2 x 2 on 2 cores would spin)
     env = dict(os.environ, OMP_NUM_THREADS=str(threads), OMP_WAIT_POLICY="PASSIVE",
-               MPIR_CVAR_CH4_PROGRESS_THROTTLE="true",
-               MPIR_CVAR_CH4_PROGRESS_THROTTLE_NO_PROGRESS_COUNT="1")
+               **SLEEPING_RANKS)
     subprocess.run(cmd, check=True, cwd=scene, timeout=600, env=env, capture_output=True)
 
 

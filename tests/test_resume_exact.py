@@ -18,10 +18,9 @@ from jkrdt import rundir
 from jkrdt.materials import ICE
 from jkrdt.scene import Scene
 
+from conftest import SLEEPING_RANKS
+
 BIN = Path(sys.executable).parent
-# more ranks than cores: ranks that sleep while they wait, not MPICH's polling
-SLEEPING_RANKS = dict(MPIR_CVAR_CH4_PROGRESS_THROTTLE="true",
-                      MPIR_CVAR_CH4_PROGRESS_THROTTLE_NO_PROGRESS_COUNT="1")
 HERE = Path(__file__).resolve().parent
 EVERY, CHUNKS = 300, 4
 

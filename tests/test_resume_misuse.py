@@ -18,13 +18,13 @@ from jkrdt.analysis.tables import read_csv
 from jkrdt.materials import ICE
 from jkrdt.scene import Scene
 
+from conftest import SLEEPING_RANKS
 from cut_off import RULE, straight_and_cut
 
 BIN = Path(sys.executable).parent
 JKRDT = str(BIN / "jkrdt")
 # more ranks than cores: ranks that sleep while they wait
-SLEEPING = dict(MPIR_CVAR_CH4_PROGRESS_THROTTLE="true",
-                MPIR_CVAR_CH4_PROGRESS_THROTTLE_NO_PROGRESS_COUNT="1", OMP_NUM_THREADS="1")
+SLEEPING = dict(SLEEPING_RANKS, OMP_NUM_THREADS="1")
 
 
 def deck_run(scene: Path, out: Path, ranks: int, **variables) -> dict:
