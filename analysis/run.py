@@ -63,15 +63,17 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
                                 "'jkrdt setup' (jkrdt.rundir.write) and run there")
     meta = rundir.read_metadata(run)
     scene = rundir.from_metadata(meta)
-    status = run_status(run)
+    log = run / rundir.LOG          # read once: the status, the thermo, the status again
+    text = log.read_text(errors="replace") if log.exists() else None
+    status = run_status(run, text=text)
     if status.stop_reason in ("error", IN_PROGRESS) and not partial:
         raise RunNotComplete(f"{run}: {status.problem}; analyse what is there with --partial")
     s = scene.scales
     tolerance = s.delta_c if tolerance is None else tolerance
     n_tar, n_pro = scene.n_tar, scene.n_pro
     budget, thermo = None, None
-    if (run / rundir.LOG).exists():
-        thermo = read_thermo(run / rundir.LOG)
+    if text is not None:
+        thermo = read_thermo(log, text=text)
         budget = energy_budget(thermo)
     atoms, contacts, checks = (run / name for name in (rundir.ATOMS,
                                                         rundir.CONTACTS,
@@ -110,7 +112,7 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
     final = dumped[-1] if last_step == last_frame else \
         {name: rows[-1][name] for name in CollisionOutcome.MEASURES}
     if status.stop_reason != IN_PROGRESS:
-        status = run_status(run, last_dump_step=last_frame)
+        status = run_status(run, last_dump_step=last_frame, text=text)
     if status.problem and not partial:
         raise RunNotComplete(f"{run}: {status.problem}; analyse what is there with --partial")
     n_k = n_tar + n_pro - 2

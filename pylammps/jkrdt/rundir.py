@@ -226,13 +226,15 @@ def write_deck(directory, scene: Scene | None = None) -> Path:
 
 
 # ---- the log: thermo, status ---------------------------------------------------------
-def read_thermo(log) -> dict:
+def read_thermo(log, text: str | None = None) -> dict:
     """Columns of every thermo block in ``log`` (numpy arrays), concatenated (repeated steps
-    dropped); the energy budget they add up to is ``jkrdt.ledger.energy_budget``."""
+    dropped); the energy budget they add up to is ``jkrdt.ledger.energy_budget``. ``text``:
+    the log's text, when the caller has read it already."""
     import numpy as np
 
     columns, columns_done, rows = None, None, []
-    for line in Path(log).read_text().splitlines():
+    text = Path(log).read_text() if text is None else text
+    for line in text.splitlines():
         words = line.split()
         if words and words[0] == "Step":
             columns = words
@@ -275,9 +277,10 @@ def _settle_fields(line: str) -> dict:
     return dict(zip(words[::2], words[1::2]))
 
 
-def run_status(run, last_dump_step: int | None = None) -> RunStatus:
-    """The status of run directory ``run`` from its log; with ``last_dump_step``, also
-    whether the dumps reach the end of the run.
+def run_status(run, last_dump_step: int | None = None, text: str | None = None) -> RunStatus:
+    """The status of run directory ``run`` from its log (``text``: the log's text, when the
+    caller has read it already); with ``last_dump_step``, also whether the dumps reach the
+    end of the run.
 
     * settled / cap: the last line the settle fix writes when it ends a run;
     * steps: a run of a fixed number of steps (no settle rule) that completed;
@@ -296,7 +299,7 @@ def run_status(run, last_dump_step: int | None = None) -> RunStatus:
             return RunStatus(IN_PROGRESS, None, f"the run is starting ({holder})")
         return RunStatus("cut off", None, f"{log} does not exist: no way to tell how the run "
                          "ended")
-    lines = log.read_text(errors="replace").splitlines()
+    lines = (log.read_text(errors="replace") if text is None else text).splitlines()
     errors = [line.strip() for line in lines if line.startswith("ERROR")]
     settle = [_settle_fields(line) for line in lines if line.startswith(SETTLE_LINE)]
     header = [k for k, line in enumerate(lines) if line.split()[:1] == ["Step"]]
