@@ -179,20 +179,21 @@ def pictures(run: Path, scene, meta: dict, out: dict, rows: list[dict], measured
         when += (f", t = {out['time_end'] * 1e9:.0f} ns = {out['time_end_over_tc']:.0f} t_c; "
                  f"max |dE|/E_imp = {out['energy_error']:.1e}")
     frame = out["last_frame_step"]
+    later = frame != out["last_step"]      # the outcome is a check's after the last frame
     step_s = scene.time_step()[0] * s.t_c          # the time of a frame without a log
     frame_row = next((r for r in rows if r["step"] == frame), None)
     frame_time = frame_row.get("time", frame * step_s) if frame_row else frame * step_s
     moments = [(rows[0]["step"], rows[0].get("time", rows[0]["step"] * step_s)),
                (frame, frame_time)]
-    if frame != out["last_step"]:
+    if later:
         when += f"\natoms drawn at step {frame}, the last atom frame"
     made = outcome(run / "outcome", measured.first_positions,
                    flown(measured.positions, measured, frame_time), measured.types,
                    measured.labels, scene.radius, scene.dim, moments, s.t_c, b=meta.get("b"),
                    title=f"{title}\n{when}", departed=measured.departed_at > 0,
-                   end_label="end" if frame == out["last_step"] else "last atom frame")
+                   end_label="last atom frame" if later else "end")
     made += timeline(run / "timeline", rows, n_total, meta["E_imp"], s.t_c, title,
-                     last_frame=None if frame == out["last_step"] else frame_time)
+                     last_frame=frame_time if later else None)
     if budget is not None:
         made += energy_partition(run / "energy", thermo["Time"], budget, meta["E_imp"], title)
     return [str(p) for p in made]

@@ -265,13 +265,14 @@ def plan(spec: dict, campaign) -> list[tuple[float, float, int, Path]]:
 def left(spec_path, campaign) -> str:
     """What a stopped campaign leaves, in a few lines: the runs finished (and failed), those
     cut off (to be resumed), and how many have not started."""
-    todo = plan(read_spec(spec_path), campaign)
-    done = [d for *_, d in todo if rundir.finished(d)]
+    runs = [d for *_, d in plan(read_spec(spec_path), campaign)]
+    ended = {d: rundir.finished(d) for d in runs}          # each outcome.json read once
+    done = [d for d in runs if ended[d]]
     failed = [d for d in done if rundir.failed(d)]
-    cut = [d for *_, d in todo if not rundir.finished(d) and (d / rundir.LOG).exists()]
-    lines = [f"{len(done)} of {len(todo)} runs finished"
+    cut = [d for d in runs if not ended[d] and (d / rundir.LOG).exists()]
+    lines = [f"{len(done)} of {len(runs)} runs finished"
              + (f" ({len(failed)} failed)" if failed else "")
-             + f", {len(cut)} cut off, {len(todo) - len(done) - len(cut)} not started"]
+             + f", {len(cut)} cut off, {len(runs) - len(done) - len(cut)} not started"]
     lines += [f"  cut off, resumes from its last restart file: {d}" for d in cut]
     return "\n".join(lines)
 

@@ -78,7 +78,7 @@ class CheckLines:
         table's own (its ``wall`` column, the run's seconds at each check)."""
         table = complete_rows(self.out / rundir.CHECKS)
         new = [k for k, r in enumerate(table) if r["step"] > self.seen]
-        error = self.energy_error() if new else None    # the log, read once per poll
+        error, read = None, False      # the log: read once per poll, and only for a line shown
         for k in new:
             row = table[k]
             if self.first_step is None:
@@ -87,11 +87,15 @@ class CheckLines:
             if wall is not None and wall < 0:      # a table of an older build: its clock
                 wall = None                        # started again at a resume
                 self.first_step, self.first_wall = int(row["step"]), row["wall"]
-            text = self.prefix + self.line(row, wall, error)
+            due = self.last_shown is None or time.monotonic() - self.last_shown >= self.every_s
+            if self.bar is not None or due:
+                if not read:
+                    error, read = self.energy_error(), True
+                text = self.prefix + self.line(row, wall, error)
             if self.bar is not None:
                 self.bar.write(text)
                 self.bar.update(int(row["step"]) - self.seen)
-            elif self.last_shown is None or time.monotonic() - self.last_shown >= self.every_s:
+            elif due:
                 print(text, file=self.stream, flush=True)
                 self.last_shown = time.monotonic()
             self.seen = int(row["step"])

@@ -313,7 +313,8 @@ def run_status(run, last_dump_step: int | None = None, text: str | None = None) 
             last_step = int(words[0])
     if errors:
         return RunStatus("error", last_step, f"the run failed: {errors[-1]}", errors[-1])
-    if holder and not any(line.startswith(FINISH_LINE) for line in lines):
+    whole = any(line.startswith(FINISH_LINE) for line in lines)
+    if holder and not whole:
         return RunStatus(IN_PROGRESS, last_step, f"in progress at step {last_step} ({holder})")
     if header and (not loops or loops[-1] < header[-1]):
         return RunStatus("cut off", last_step, f"{log} ends inside a run at step {last_step}: "
@@ -324,7 +325,7 @@ def run_status(run, last_dump_step: int | None = None, text: str | None = None) 
                          f"run at step {last_step} for wider neighbor bins, and the deck did "
                          "not run the next part (a deck written before runs in parts): write "
                          "the scene anew (jkrdt setup ... --force) and run it again")
-    if not any(line.startswith(FINISH_LINE) for line in lines):
+    if not whole:
         return RunStatus("cut off", last_step, f"{log} stops at step {last_step} without its "
                          f"last line ('{FINISH_LINE} ...'): the run was cut off between two "
                          "of its run commands; run it again (jkrdt run), let jkrdt campaign "
