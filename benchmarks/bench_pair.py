@@ -46,7 +46,8 @@ from jkrdt.scene import pair_coeff
 
 R = 1.0e-7
 BIN = Path(sys.executable).parent
-DECK = """
+# the deck's first lines, before its pair style: every benchmark's scene read the same way
+PROLOGUE = """
 units si
 atom_style sphere
 atom_modify map array
@@ -54,7 +55,8 @@ boundary m m m
 newton off
 comm_modify vel yes
 read_data {data}
-{pair}
+"""
+DECK = PROLOGUE + """{pair}
 neighbor {skin!r} bin
 neigh_modify every 1 delay 0 check yes
 fix integrate all nve/sphere
@@ -98,6 +100,33 @@ def scene(n: int, where: Path) -> Path:
                         "--v", "20", "--b-off", "0.3", "--seed", "3", "--force",
                         "--out", str(out)], check=True)
     return (out / rundir.DATA).resolve()
+
+
+def two_builds(doc: str, steps: int, tag: str) -> argparse.ArgumentParser:
+    """The command line of a benchmark that runs this build of the plugin against another
+    (callgrind_pair, same_bits): --baseline, --this, --size, --steps, --scenes, --tag."""
+    p = argparse.ArgumentParser(description=doc,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--baseline", type=Path, required=True,
+                   help="an older jkrdtplugin.so to compare with")
+    p.add_argument("--this", type=Path, default=None,
+                   help="the build to measure (default: the installed plugin)")
+    p.add_argument("--size", type=int, default=2500, help="grains per aggregate")
+    p.add_argument("--steps", type=int, default=steps)
+    p.add_argument("--scenes", type=Path, default=Path(tempfile.gettempdir()) / "jkrdt_bench")
+    p.add_argument("--tag", default=tag)
+    return p
+
+
+def copy_builds(where: Path, this: Path, baseline: Path) -> dict:
+    """Each build alone in a folder of its own (LAMMPS loads every plugin of a folder):
+    {"this": path, "baseline": path}."""
+    builds = {}
+    for name, so in (("this", this), ("baseline", baseline)):
+        (where / name).mkdir()
+        builds[name] = where / name / "jkrdtplugin.so"
+        shutil.copy(so, builds[name])
+    return builds
 
 
 def lammps_command(ranks: int, threads: int, plugin: Path | None) -> tuple[list, dict]:

@@ -1,6 +1,7 @@
 """Instructions of the pair loop, counted by callgrind: this build against another.
 
-    python benchmarks/callgrind_pair.py --baseline OLD_PLUGIN.so [--size 2500] [--steps 200]
+    python benchmarks/callgrind_pair.py --baseline OLD_PLUGIN.so --this NEW_PLUGIN.so
+                                        [--size 2500] [--steps 200]
 
 Callgrind counts instructions, not seconds: the same binary and input give the same count
 whatever else the machine runs, so a small change in the per-pair step (a counter, a
@@ -14,7 +15,6 @@ ratio to the baseline's. Writes benchmarks/speed/callgrind_<tag>.json; asserts n
 
 from __future__ import annotations
 
-import argparse
 import json
 import re
 import shutil
@@ -24,7 +24,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from bench_pair import DECK, JKRDT_BARE, JKRDT_FULL, lammps_command, scene
+from bench_pair import DECK, JKRDT_BARE, JKRDT_FULL, copy_builds, lammps_command, scene, two_builds
 from jkrdt import plugin as installed
 from jkrdt.materials import ICE, scales
 
@@ -42,24 +42,19 @@ def count(deck: str, workdir: Path, plugin: Path) -> dict:
                    capture_output=True)
     total = subprocess.run(["callgrind_annotate", str(out)], capture_output=True, text=True,
                            check=True).stdout
-    ir = int(re.search(r"([0-9,]+) \(100.0%\)\s+PROGRAM TOTALS", total).group(1)
-             .replace(",", ""))
+    found = re.search(r"([0-9,]+) \(100.0%\)\s+PROGRAM TOTALS", total)
+    if found is None:
+        sys.exit(f"callgrind_pair: no instructions counted in PairJKRDT::compute of {plugin}: "
+                 "that build has no symbol table (the wheel's is stripped); build one with "
+                 "'cmake -B build && cmake --build build' and give --this build/jkrdtplugin.so")
+    ir = int(found.group(1).replace(",", ""))
     log = (workdir / "log.bench").read_text()
     pairs = int(re.search(r"Total # of neighbors = (\d+)", log).group(1))
     return dict(instructions=ir, list_pairs=pairs)
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--baseline", type=Path, required=True,
-                   help="an older jkrdtplugin.so to compare with")
-    p.add_argument("--this", type=Path, default=None,
-                   help="the build to measure (default: the installed plugin)")
-    p.add_argument("--size", type=int, default=2500, help="grains per aggregate")
-    p.add_argument("--steps", type=int, default=200)
-    p.add_argument("--scenes", type=Path, default=Path(tempfile.gettempdir()) / "jkrdt_bench")
-    p.add_argument("--tag", default="events")
+    p = two_builds(__doc__, steps=200, tag="events")
     args = p.parse_args(argv)
     if shutil.which("valgrind") is None:
         p.error("valgrind is not installed: apt-get install valgrind")
@@ -70,17 +65,14 @@ def main(argv=None) -> int:
                date=time.strftime("%Y-%m-%d"), command=" ".join(sys.argv), models={})
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        for tag, so in (("this", args.this or installed.plugin_path()),
-                        ("baseline", args.baseline)):
-            (tmp / tag).mkdir()
-            shutil.copy(so, tmp / tag / "jkrdtplugin.so")
+        builds = copy_builds(tmp, args.this or installed.plugin_path(), args.baseline)
         for model, pair in (("full", JKRDT_FULL), ("frictionless", JKRDT_BARE)):
             deck = DECK.format(data=data, pair=pair, skin=1.0e-8, steps=args.steps, dt=dt)
             row = {}
             for tag in ("this", "baseline"):
                 work = tmp / f"{tag}_{model}"
                 work.mkdir()
-                c = count(deck, work, tmp / tag / "jkrdtplugin.so")
+                c = count(deck, work, builds[tag])
                 c["per_list_pair"] = c["instructions"] / (c["list_pairs"] * (args.steps + 1))
                 row[tag] = c
             row["ratio"] = row["this"]["instructions"] / row["baseline"]["instructions"]

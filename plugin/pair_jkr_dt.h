@@ -4,8 +4,10 @@
    This class is the LAMMPS glue, in layers that call downward only:
      pair_jkr_dt.cpp             its own state, the look-ups, the local view
      pair_jkr_dt_init.cpp        init_style: checks, constants, the contact store
-     pair_jkr_dt_loop.cpp        the neighbor-list loop, contact formation and
-                                 breaking, energy and dissipation bookkeeping
+     pair_jkr_dt_loop.cpp        the neighbor-list loop: threads, blocks of pairs,
+                                 the LEAN runs, the sums
+     pair_jkr_dt_step.h          one pair's step: motion, guards, the contact kernel,
+                                 loads, dissipation and energy bookkeeping
      pair_jkr_dt_coeff.cpp       the pair_coeff keywords, mixing, data and restart files
      pair_jkr_dt_guards.cpp      t_c, the time-step limits, the errors of a run
      pair_jkr_dt_bins.cpp        bins that grow with the box
@@ -172,6 +174,11 @@ class PairJKRDT : public Pair {
   // field this build needs reads back empty
   static std::vector<double> made_with_record(const std::vector<Param> &param);
   static std::vector<Param> made_with_params(const std::vector<double> &record);
+  // init_style's parts (pair_jkr_dt_init.cpp)
+  void check_atom_style() const;
+  void find_contact_constants();
+  void choose_kernel();
+  void attach_contact_store();
   void find_max_radii();
   void check_periodic_images(double cutmax);
   void check_neighbor_settings() const;
@@ -208,6 +215,19 @@ class PairJKRDT : public Pair {
     bigint contact_ends;            // bonded contacts counted once per owned atom
     Trouble trouble;                // the first problem met; the thread stops there
   };
+  // the pair loop's parts (pair_jkr_dt_step.h): what a pair's step reads, the constants'
+  // look-up, how a pair's evaluation ends, a pair as evaluated, a block of the list's
+  // pairs, one pair's step (general or LEAN), and one thread's pass (pair_jkr_dt_loop.cpp)
+  struct View;
+  struct Constants;
+  enum class Eval;
+  struct Done;
+  template <bool TANGENTIAL> struct Block;
+  template <bool TANGENTIAL, bool LEAN> struct PairStep;
+  template <bool TANGENTIAL, bool AVX2> struct Pass;
+  View view(int eflag, bool tally_atoms, ConstantsBy by, const Accumulator &acc) const;
+  bool lean_enabled = true;    // pair_style ... lean yes (default) or no: every pair takes
+                               // the general step (the same bits, slower; for testing)
   // the pair loop, written once and compiled twice: for any x86-64 (SSE2) and for CPUs
   // with AVX2 (AVX2: the instantiation its out-of-line parts are compiled for too), chosen
   // when the run starts (pair_style ... kernel auto|portable)
@@ -227,6 +247,7 @@ class PairJKRDT : public Pair {
   bool kernel_auto;    // pair_style ... kernel auto (default) or portable
   bool kernel_avx2;    // this run's loop is the AVX2 one
   bool kernel_logged = false;
+  bool lean_logged = true;
   [[noreturn]] void report(const Trouble &t) const;
   int nthreads_used() const;
   std::vector<int> thread_from;       // first ilist entry of each thread (threaded runs) ...

@@ -129,9 +129,11 @@ PairJKRDT::Input nothing_given()
 void PairJKRDT::settings(int narg, char **arg)
 {
   // pair_style jkr/dt [dt_check error|warn|off] [bins bounded|box] [kernel auto|portable]
+  //                   [lean yes|no]
   dt_check = DT_CHECK_ERROR;
   bins_bounded = true;
   kernel_auto = true;
+  lean_enabled = true;
   data_contacts = 0;    // the deliberate fresh start from a marked data file
   if (fix_contacts && !modify->get_fix_by_id(FIX_ID)) {    // given anew after an unfix
     fix_contacts = nullptr;
@@ -157,11 +159,16 @@ void PairJKRDT::settings(int narg, char **arg)
       else if (value == "portable") kernel_auto = false;
       else
         error->all(FLERR, "pair_style jkr/dt: kernel takes auto or portable (got '{}')", value);
+    } else if (key == "lean") {
+      if (value == "yes") lean_enabled = true;
+      else if (value == "no") lean_enabled = false;
+      else
+        error->all(FLERR, "pair_style jkr/dt: lean takes yes or no (got '{}')", value);
     } else {
       error->all(FLERR,
                  "pair_style jkr/dt: unknown setting '{}'; the settings are 'dt_check "
-                 "error|warn|off', 'bins bounded|box' and 'kernel auto|portable' (material "
-                 "parameters go in pair_coeff)",
+                 "error|warn|off', 'bins bounded|box', 'kernel auto|portable' and 'lean "
+                 "yes|no' (material parameters go in pair_coeff)",
                  key);
     }
   }

@@ -29,21 +29,7 @@ using Contacts = FixJKRDTContacts;
 
 void PairJKRDT::init_style()
 {
-  if (!atom->radius_flag || !atom->rmass_flag || !atom->omega_flag)
-    error->all(FLERR,
-               "pair jkr/dt requires atom_style sphere (per-atom radius, rmass and omega)");
-  if (!comm->ghost_velocity)
-    error->all(FLERR,
-               "pair jkr/dt requires velocities of ghost atoms: add 'comm_modify vel yes'");
-  if (!atom->tag_enable)
-    error->all(FLERR, "pair jkr/dt requires atom IDs: contacts are keyed by the IDs of the pair");
-  if (!atom->torque_flag)
-    error->all(FLERR, "pair jkr/dt requires per-atom torque: use atom_style sphere");
-  if (update->whichflag == 2)
-    error->all(FLERR,
-               "pair jkr/dt cannot be minimized: its contacts carry history (pointers, twist, "
-               "breaking). Relax with a damped run instead (e.g. fix viscous)");
-
+  check_atom_style();
   find_max_radii();
   double cutmax = 0.0;
   std::vector<Param> fresh(param.size());
@@ -68,6 +54,47 @@ void PairJKRDT::init_style()
   check_integrator();
   check_data_file_contacts();
   find_contact_time();
+  find_contact_constants();
+
+  const int departed = group->find(DEPARTED_GROUP);
+  departed_bit = departed >= 0 ? group->bitmask[departed] : 0;
+
+  neighbor->add_request(this, NeighConst::REQ_NEWTON_OFF);
+  start_bins(cutmax + neighbor->skin);
+  choose_kernel();
+  attach_contact_store();
+}
+
+/* ----------------------------------------------------------------------
+   what the pair needs of the atoms and the run
+------------------------------------------------------------------------- */
+
+void PairJKRDT::check_atom_style() const
+{
+  if (!atom->radius_flag || !atom->rmass_flag || !atom->omega_flag)
+    error->all(FLERR,
+               "pair jkr/dt requires atom_style sphere (per-atom radius, rmass and omega)");
+  if (!comm->ghost_velocity)
+    error->all(FLERR,
+               "pair jkr/dt requires velocities of ghost atoms: add 'comm_modify vel yes'");
+  if (!atom->tag_enable)
+    error->all(FLERR, "pair jkr/dt requires atom IDs: contacts are keyed by the IDs of the pair");
+  if (!atom->torque_flag)
+    error->all(FLERR, "pair jkr/dt requires per-atom torque: use atom_style sphere");
+  if (update->whichflag == 2)
+    error->all(FLERR,
+               "pair jkr/dt cannot be minimized: its contacts carry history (pointers, twist, "
+               "breaking). Relax with a damped run instead (e.g. fix viscous)");
+}
+
+/* ----------------------------------------------------------------------
+   the constants of the contacts of every type pair present, and where the
+   pair loop finds them (constants_by): whether each type has one radius,
+   and whether one set serves the whole scene
+------------------------------------------------------------------------- */
+
+void PairJKRDT::find_contact_constants()
+{
   one_radius_per_type = true;
   any_tangential = false;
   type_constants.assign(param.size(), JKRDT::ContactConstants{});
@@ -97,31 +124,44 @@ void PairJKRDT::init_style()
         break;
       }
     }
+}
 
-  const int departed = group->find(DEPARTED_GROUP);
-  departed_bit = departed >= 0 ? group->bitmask[departed] : 0;
+/* ----------------------------------------------------------------------
+   the AVX2 loop where this CPU has AVX2 (kernel auto): the same bits,
+   fewer instructions; the log says which loop and how many threads
+------------------------------------------------------------------------- */
 
-  neighbor->add_request(this, NeighConst::REQ_NEWTON_OFF);
-  start_bins(cutmax + neighbor->skin);
-
-  // the AVX2 loop where this CPU has AVX2 (kernel auto): the same bits, fewer instructions
+void PairJKRDT::choose_kernel()
+{
 #if JKRDT_AVX2
   kernel_avx2 = kernel_auto && __builtin_cpu_supports("avx2");
 #else
   kernel_avx2 = false;
 #endif
   const int nthreads = nthreads_used();
-  if (comm->me == 0 && (nthreads != threads_logged || kernel_avx2 != kernel_logged))
-    utils::logmesg(lmp, "pair jkr/dt: {} OpenMP thread{} per rank, {} pair loop\n", nthreads,
-                   nthreads > 1 ? "s" : "", kernel_avx2 ? "AVX2" : "portable");
+  if (comm->me == 0 &&
+      (nthreads != threads_logged || kernel_avx2 != kernel_logged || lean_enabled != lean_logged))
+    utils::logmesg(lmp, "pair jkr/dt: {} OpenMP thread{} per rank, {} pair loop{}\n", nthreads,
+                   nthreads > 1 ? "s" : "", kernel_avx2 ? "AVX2" : "portable",
+                   lean_enabled ? "" : ", every pair on the general step (lean no)");
   threads_logged = nthreads;
   kernel_logged = kernel_avx2;
+  lean_logged = lean_enabled;
 #if !defined(_OPENMP)
   if (comm->me == 0 && comm->nthreads > 1)
     error->warning(FLERR, "pair jkr/dt was built without OpenMP: it runs on 1 thread of the {} "
                           "asked for; rebuild with an OpenMP compiler", comm->nthreads);
 #endif
+}
 
+/* ----------------------------------------------------------------------
+   the contact store this pair writes: found, or made (with the contacts a
+   restart file brought back), told the state's layout, what the contacts
+   are made with, and the hooks it calls back
+------------------------------------------------------------------------- */
+
+void PairJKRDT::attach_contact_store()
+{
   auto *fix = modify->get_fix_by_id(FIX_ID);
   if (!fix && fix_contacts && contacts_at_run_end > 0)
     error->all(FLERR,
