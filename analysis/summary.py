@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from jkrdt import protocol, rundir
+from jkrdt import ledger, protocol, rundir
 from jkrdt.rundir import write_json
 from jkrdt.stopping import COMPLETE
 
@@ -32,8 +32,11 @@ N_CUM_AT = (1, 10, 100, 1000)
 #: ``diagnostics`` names them: contacts made and cut (Figs. C.3, C.4), the energy
 #: dissipated in all, by making and breaking contacts, by damping (Figs. C.1, C.2) and by
 #: the tangential channels, all over E_imp; N_cum(<= N) at N_CUM_AT
-DIAGNOSTICS = ["N_con", "N_cut", "E_dis_tot", "E_dis_c", "E_dis_v", "E_dis_sliding",
-               "E_dis_rolling", "E_dis_twisting", *(f"N_cum_{n}" for n in N_CUM_AT)]
+#: the paper's name of a channel's dissipation (the others: E_dis_<channel>)
+PAPER_CHANNEL = {"events": "E_dis_c", "damping": "E_dis_v"}
+CHANNEL_DIAGNOSTICS = [PAPER_CHANNEL.get(c, f"E_dis_{c}") for c in ledger.CHANNELS]
+DIAGNOSTICS = ["N_con", "N_cut", "E_dis_tot", *CHANNEL_DIAGNOSTICS,
+               *(f"N_cum_{n}" for n in N_CUM_AT)]
 SCALARS = ["model", "material", "xi_crit", "tvis", "kind", "dimension", "N_tar", "N_pro",
            "v_col", "B_off", "B_off2", "seed", "radius", "E_imp", "n_k", "E_imp_over_nk_Eroll",
            "E_imp_over_nk_Ebreak", "step", "n_total", "n_largest", "n_second", "n_fragments",
@@ -165,9 +168,8 @@ def diagnostics(out: dict) -> dict:
     at = cumulative_on(np.array(N_CUM_AT), out["fragment_sizes"], out["N_cum"]) \
         if out.get("fragment_sizes") else [None] * len(N_CUM_AT)
     return dict(N_con=out.get("N_con"), N_cut=out.get("N_cut"),
-                E_dis_tot=out.get("dissipated_fraction"), E_dis_c=by.get("events"),
-                E_dis_v=by.get("damping"), E_dis_sliding=by.get("sliding"),
-                E_dis_rolling=by.get("rolling"), E_dis_twisting=by.get("twisting"),
+                E_dis_tot=out.get("dissipated_fraction"),
+                **{name: by.get(c) for c, name in zip(ledger.CHANNELS, CHANNEL_DIAGNOSTICS)},
                 **{f"N_cum_{n}": None if c is None else int(c) for n, c in zip(N_CUM_AT, at)})
 
 

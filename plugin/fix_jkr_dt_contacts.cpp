@@ -45,7 +45,7 @@ FixJKRDTContacts::FixJKRDTContacts(LAMMPS *lmp, int narg, char **arg) :
   restart_peratom = 1;
   create_attribute = 1;
   peratom_flag = 1;
-  size_peratom_cols = NLEDGER;
+  size_peratom_cols = JKRDT::NLEDGER;
   peratom_freq = 1;
   scalar_flag = 1;
   global_freq = 1;
@@ -497,7 +497,7 @@ void FixJKRDTContacts::longest_row(int n)
 // ledger, owner ID
 void FixJKRDTContacts::set_exchange_size()
 {
-  maxexchange = 2 + NLEDGER + maxpartner * (1 + dnum);
+  maxexchange = 2 + JKRDT::NLEDGER + maxpartner * (1 + dnum);
 }
 
 /* ----------------------------------------------------------------------
@@ -511,7 +511,7 @@ void FixJKRDTContacts::grow_arrays(int nmax)
   memory->grow(capacity, nmax, "jkr/dt:capacity");
   partner = (tagint **) memory->srealloc(partner, sizeof(tagint *) * nmax, "jkr/dt:partner");
   values = (double **) memory->srealloc(values, sizeof(double *) * nmax, "jkr/dt:values");
-  memory->grow(ledger, nmax, NLEDGER, "jkr/dt:ledger");
+  memory->grow(ledger, nmax, JKRDT::NLEDGER, "jkr/dt:ledger");
   memory->grow(owner, nmax, "jkr/dt:owner");
   nmax_alloc = nmax;
   for (int i = oldmax; i < nmax; i++) set_arrays(i);
@@ -527,7 +527,7 @@ void FixJKRDTContacts::copy_arrays(int i, int j, int /*delflag*/)
   capacity[j] = capacity[i];
   partner[j] = partner[i];
   values[j] = values[i];
-  std::copy_n(ledger[i], (int) NLEDGER, ledger[j]);
+  std::copy_n(ledger[i], (int) JKRDT::NLEDGER, ledger[j]);
   owner[j] = owner[i];
 }
 
@@ -535,7 +535,7 @@ void FixJKRDTContacts::set_arrays(int i)
 {
   fresh(i);
   owner[i] = 0;
-  std::fill(ledger[i], ledger[i] + NLEDGER, 0.0);
+  std::fill(ledger[i], ledger[i] + JKRDT::NLEDGER, 0.0);
 }
 
 /* ----------------------------------------------------------------------
@@ -549,7 +549,7 @@ int FixJKRDTContacts::pack_exchange(int i, double *buf)
   buf[m++] = npartner[i];
   for (int k = 0; k < npartner[i]; k++) buf[m++] = ubuf(partner[i][k]).d;
   for (int k = 0; k < npartner[i] * dnum; k++) buf[m++] = values[i][k];
-  for (int l = 0; l < NLEDGER; l++) buf[m++] = ledger[i][l];
+  for (int l = 0; l < JKRDT::NLEDGER; l++) buf[m++] = ledger[i][l];
   buf[m++] = ubuf(owner[i]).d;
   return m;
 }
@@ -563,7 +563,7 @@ int FixJKRDTContacts::unpack_exchange(int nlocal, double *buf)
   npartner[nlocal] = n;
   for (int k = 0; k < n; k++) partner[nlocal][k] = (tagint) ubuf(buf[m++]).i;
   for (int k = 0; k < n * dnum; k++) values[nlocal][k] = buf[m++];
-  for (int l = 0; l < NLEDGER; l++) ledger[nlocal][l] = buf[m++];
+  for (int l = 0; l < JKRDT::NLEDGER; l++) ledger[nlocal][l] = buf[m++];
   owner[nlocal] = (tagint) ubuf(buf[m++]).i;
   return m;
 }
@@ -605,8 +605,8 @@ void FixJKRDTContacts::unpack_restart(int nlocal, int nth)
   // cut were counted hold the losses alone (their counts start at 0); files written before
   // the owner ID was stored end after the ledger: their IDs are the atoms' own
   const int rest = static_cast<int>(record[0]) - static_cast<int>(buf - record);
-  const int nled = rest > NLOSS + 1 ? NLEDGER : NLOSS;
-  std::fill(ledger[nlocal], ledger[nlocal] + NLEDGER, 0.0);
+  const int nled = rest > JKRDT::NLOSS + 1 ? int(JKRDT::NLEDGER) : int(JKRDT::NLOSS);
+  std::fill(ledger[nlocal], ledger[nlocal] + JKRDT::NLEDGER, 0.0);
   for (int l = 0; l < nled; l++) ledger[nlocal][l] = *buf++;
   const bool has_owner = rest > nled;
   owner[nlocal] = has_owner ? (tagint) ubuf(*buf).i : atom->tag[nlocal];
@@ -615,7 +615,7 @@ void FixJKRDTContacts::unpack_restart(int nlocal, int nth)
 int FixJKRDTContacts::size_restart(int i)
 {
   to_rows();    // a restart file written during a run: the rows take the state first
-  return 4 + npartner[i] * (1 + dnum) + NLEDGER;
+  return 4 + npartner[i] * (1 + dnum) + JKRDT::NLEDGER;
 }
 
 // called on every rank by write_restart, so it may reduce over ranks
@@ -625,7 +625,7 @@ int FixJKRDTContacts::maxsize_restart()
   int nmine = 0, nall = 0;
   for (int i = 0; i < atom->nlocal; i++) nmine = std::max(nmine, npartner[i]);
   MPI_Allreduce(&nmine, &nall, 1, MPI_INT, MPI_MAX, world);
-  return 4 + nall * (1 + dnum) + NLEDGER;    // as size_restart()
+  return 4 + nall * (1 + dnum) + JKRDT::NLEDGER;    // as size_restart()
 }
 
 /* ----------------------------------------------------------------------
@@ -660,7 +660,7 @@ double FixJKRDTContacts::memory_usage()
 {
   const double nmax = nmax_alloc;
   return nmax * (2 * sizeof(int) + sizeof(tagint *) + sizeof(double *) +
-                 NLEDGER * sizeof(double) + sizeof(tagint)) +
+                 JKRDT::NLEDGER * sizeof(double) + sizeof(tagint)) +
       (double) tag_arena.bytes() + (double) value_arena.bytes() +
       (double) maxslot * (1 + slot_dnum * sizeof(double)) + (double) maxfirst * sizeof(int);
 }

@@ -72,19 +72,6 @@ class FixJKRDTContacts : public Fix {
     std::function<void()> on_lost_contact;    // a stored contact left the list: say why, stop
   } writer;
 
-  // ledger columns: energy dissipated by channel (the kernel's loss channels), then the
-  // contacts made and cut (halves: each event is booked half to each atom)
-  enum Ledger {
-    FORM_BREAK = JKRDT::LOSS_FORM_BREAK,
-    DAMPING = JKRDT::LOSS_DAMPING,
-    SLIDING = JKRDT::LOSS_SLIDING,
-    ROLLING = JKRDT::LOSS_ROLLING,
-    TWISTING = JKRDT::LOSS_TWISTING,
-    NLOSS = JKRDT::NLOSS,
-    MADE = JKRDT::LEDGER_MADE,
-    CUT = JKRDT::LEDGER_CUT,
-    NLEDGER = JKRDT::NLEDGER
-  };
 
   FixJKRDTContacts(class LAMMPS *, int, char **);
   ~FixJKRDTContacts() override;
@@ -142,7 +129,7 @@ class FixJKRDTContacts : public Fix {
   int *npartner;        // number of bonded contacts of each atom
   tagint **partner;     // atom IDs of the partners (each atom's row, in tag_arena)
   double **values;      // per-contact values, dnum per contact (in value_arena)
-  double **ledger;      // dissipated energy by channel, NLEDGER per atom
+  double **ledger;      // dissipated energy by channel, JKRDT::NLEDGER columns per atom
   tagint *owner;        // the atom's ID when its contacts were stored (renumbering check)
   int dnum;             // doubles per contact under the current layout
 

@@ -164,7 +164,7 @@ FixJKRDTSettle::Partition FixJKRDTSettle::partition(Graph &graph) const
   double dissipated = 0.0;
   if (C)
     for (int i = 0; i < atom->nlocal; i++)
-      for (int l = 0; l < FixJKRDTContacts::NLOSS; l++) dissipated += C->ledger[i][l];
+      for (int l = 0; l < JKRDT::NLOSS; l++) dissipated += C->ledger[i][l];
   graph.edges = FixJKRDTContacts::gather(mine, world);
   const std::vector<tagint> &edges = graph.edges;
 

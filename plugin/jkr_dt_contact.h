@@ -40,13 +40,43 @@
 
 namespace JKRDT {
 
-// where a step's dissipation goes: the columns of the energy ledger
-enum Loss { LOSS_FORM_BREAK = 0, LOSS_DAMPING, LOSS_SLIDING, LOSS_ROLLING, LOSS_TWISTING, NLOSS };
+// the normal channels of the ledger (section 2.1 and eq. A.5), declared once: X(enum, name)
+#define JKRDT_NORMAL_CHANNELS(X) X(FORM_BREAK, "events") X(DAMPING, "damping")
+
+// where a step's dissipation goes: the columns of the energy ledger, a normal channel's
+// or a tangential one's (LOSS_SLIDE, LOSS_ROLL, LOSS_TWIST, from LOSS_TANGENTIAL on)
+#define JKRDT_LOSS_ENUM(e, ...) LOSS_##e,
+enum Loss { JKRDT_NORMAL_CHANNELS(JKRDT_LOSS_ENUM) JKRDT_TANGENTIAL_CHANNELS(JKRDT_LOSS_ENUM) NLOSS };
+#undef JKRDT_LOSS_ENUM
+constexpr int LOSS_TANGENTIAL = NLOSS - NCHANNEL;
+static_assert(LOSS_TANGENTIAL + SLIDE == LOSS_SLIDE && LOSS_TANGENTIAL + TWIST == LOSS_TWIST,
+              "the tangential losses follow the normal ones, in the channels' order");
 // the ledger's columns: the losses, then the contacts made and cut in a run's steps (N_con
 // and N_cut of the 3D BPCA paper, App. C.2: formation at delta >= 0, breaking at delta <
 // -delta_c, section 2.1), half of each event to each atom, so that every rank count sums
 // them exactly
 enum LedgerColumn { LEDGER_MADE = NLOSS, LEDGER_CUT, NLEDGER };
+// compute pair jkr/dt's values: U_n, the tangential potentials, the losses, the bonded
+// contacts, and the contacts made and cut
+enum PairValue {
+  VALUE_U_N = 0,
+  VALUE_U_TANGENTIAL,
+  VALUE_LOSS = VALUE_U_TANGENTIAL + NCHANNEL,
+  VALUE_CONTACTS = VALUE_LOSS + NLOSS,
+  VALUE_MADE,
+  VALUE_CUT,
+  NVALUE
+};
+// ... and their names (Python's jkrdt.ledger.VALUES, the manual's "Output")
+#define JKRDT_NAME(e, name, ...) name,
+#define JKRDT_POTENTIAL(e, name, potential) potential,
+constexpr const char *VALUE_NAME[] = {"U_n", JKRDT_TANGENTIAL_CHANNELS(JKRDT_POTENTIAL)
+                                      JKRDT_NORMAL_CHANNELS(JKRDT_NAME)
+                                      JKRDT_TANGENTIAL_CHANNELS(JKRDT_NAME) "contacts", "made",
+                                      "cut"};
+#undef JKRDT_NAME
+#undef JKRDT_POTENTIAL
+static_assert(sizeof VALUE_NAME / sizeof VALUE_NAME[0] == NVALUE, "a name per value");
 
 // the coefficients of one type pair, after defaults and mixing
 struct Coefficients {
@@ -346,7 +376,7 @@ inline T twist_increment(const V3T<T> &d12, const V3T<T> &v12, const V3T<T> &w1,
   if (traced && !setup && (breaking || clamped)) {
     const ChannelLosses booked =
         book_tangential_step(c, m, dt, before, now, breaking ? Displacements{} : d, breaking);
-    for (int ch = 0; ch < NCHANNEL; ch++) out.loss[LOSS_SLIDING + ch] += booked.loss[ch];
+    for (int ch = 0; ch < NCHANNEL; ch++) out.loss[LOSS_TANGENTIAL + ch] += booked.loss[ch];
     out.lossy = true;
   }
   if (breaking) return;

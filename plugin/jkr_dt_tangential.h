@@ -224,7 +224,15 @@ inline DisplacementsT<T> displacements(const ContactStateT<T> &c, const V3T<T> &
    potentials, forces and torques of each channel, eqs. (11)-(27)
 ------------------------------------------------------------------------ */
 
-enum Channel { SLIDE = 0, ROLL, TWIST, NCHANNEL };
+// the tangential channels of section 2.2, declared once: X(enum, name, potential). Every
+// list of channels is made from this one and JKRDT_NORMAL_CHANNELS (jkr_dt_contact.h): the
+// ledger's columns, compute pair jkr/dt's values and their names, which Python's
+// jkrdt.ledger gives too (tests/test_structure.py compares them)
+#define JKRDT_TANGENTIAL_CHANNELS(X) X(SLIDE, "sliding", "U_s") X(ROLL, "rolling", "U_r") \
+  X(TWIST, "twisting", "U_t")
+#define JKRDT_CHANNEL_ENUM(e, name, potential) e,
+enum Channel { JKRDT_TANGENTIAL_CHANNELS(JKRDT_CHANNEL_ENUM) NCHANNEL };
+#undef JKRDT_CHANNEL_ENUM
 
 struct ChannelLoad {
   double U;    // potential, eqs. (11), (21), (25)

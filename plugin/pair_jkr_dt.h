@@ -68,7 +68,7 @@ class PairJKRDT : public Pair {
     double zeta, xi, phi;    // |zeta|, |xi|, |phi|, eqs. (10), (20), (24); 0 if off
   };
 
-  static constexpr int NPVECTOR = 12;
+  static constexpr int NPVECTOR = JKRDT::NVALUE;    // compute pair jkr/dt's values
   static const char *const FIX_ID;
   // the group of grains in fragments that have left the collision for good (fix
   // jkr/dt/settle depart): they keep their velocities but no longer move or interact

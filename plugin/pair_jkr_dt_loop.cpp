@@ -447,28 +447,28 @@ PairJKRDT::pair_loop_avx2(int ii_from, int ii_to, int eflag, bool tally_atoms, C
 #endif
 
 /* ----------------------------------------------------------------------
-   this rank's share of the 12 values of compute pair jkr/dt; compute pair
-   sums them over ranks: the potentials, the losses, the bonded contacts,
-   the contacts made and cut
+   this rank's share of the values of compute pair jkr/dt (JKRDT::PairValue);
+   compute pair sums them over ranks: the potentials, the losses, the bonded
+   contacts, the contacts made and cut
 ------------------------------------------------------------------------- */
 
 void PairJKRDT::fill_pvector(double upot, const double *utan, double contacts)
 {
+  using namespace JKRDT;
   std::fill(pvector, pvector + NPVECTOR, 0.0);
-  pvector[0] = upot;    // U_n
-  for (int ch = 0; ch < JKRDT::NCHANNEL; ch++) pvector[1 + ch] = utan[ch];    // U_s, U_r, U_t
+  pvector[VALUE_U_N] = upot;
+  for (int ch = 0; ch < NCHANNEL; ch++) pvector[VALUE_U_TANGENTIAL + ch] = utan[ch];
   const auto &C = *fix_contacts;
   for (int i = 0; i < atom->nlocal; i++) {
-    for (int l = 0; l < Contacts::NLOSS; l++) pvector[4 + l] += C.ledger[i][l];
-    pvector[10] += C.ledger[i][Contacts::MADE];
-    pvector[11] += C.ledger[i][Contacts::CUT];
+    for (int l = 0; l < NLOSS; l++) pvector[VALUE_LOSS + l] += C.ledger[i][l];
+    pvector[VALUE_MADE] += C.ledger[i][LEDGER_MADE];
+    pvector[VALUE_CUT] += C.ledger[i][LEDGER_CUT];
   }
-  pvector[9] = contacts;
+  pvector[VALUE_CONTACTS] = contacts;
   for (int l = 0; l < NPVECTOR; l++)
     if (!std::isfinite(pvector[l]))
       error->one(FLERR,
-                 "pair jkr/dt: value {} of the energy ledger is not finite at step {} (timestep "
-                 "= {:.3g} t_c): the run has blown up; reduce the timestep",
-                 l + 1, update->ntimestep, update->dt / tc_min);
+                 "pair jkr/dt: value {} ({}) of the energy ledger is not finite at step {} "
+                 "(timestep = {:.3g} t_c): the run has blown up; reduce the timestep",
+                 l + 1, VALUE_NAME[l], update->ntimestep, update->dt / tc_min);
 }
-

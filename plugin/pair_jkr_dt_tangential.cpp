@@ -59,7 +59,7 @@ void PairJKRDT::book_channels_switched_off(const std::vector<Param> &fresh, Cont
       ChannelLoad load[NCHANNEL];
       tangential_load(c, (1.0 / dist) * d12, 1.0 / dist, K.r1, K.r2, K.S.R, K.K, load);
       for (int ch = 0; ch < NCHANNEL; ch++)
-        if (off[ch]) C.ledger[i][LOSS_SLIDING + ch] += 0.5 * load[ch].U;
+        if (off[ch]) C.ledger[i][LOSS_TANGENTIAL + ch] += 0.5 * load[ch].U;
     }
   int any = 0;
   MPI_Allreduce(&unseen, &any, 1, MPI_INT, MPI_SUM, world);

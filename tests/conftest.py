@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from jkrdt import ledger as jkrdt_ledger
 from jkrdt.materials import ICE, scales
 from jkrdt.session import start_lammps
 
@@ -33,7 +34,7 @@ def jkr_potential(delta, s):
     return 4.0 * 6 ** (1 / 3) * s.F_c * s.delta_c * (0.8 * x ** 5 - 4 / 3 * x ** 3.5 + x ** 2 / 3)
 
 
-ENERGY_THERMO = "step ke c_erot pe c_p[1] c_p[5] c_p[6] c_p[7] c_p[8] c_p[9] c_p[10]"
+ENERGY_THERMO = f"step ke c_erot pe c_p[1] {' '.join(jkrdt_ledger.LEDGER)} {jkrdt_ledger.CONTACTS}"
 
 
 def two_grain_scene(lmp, separation, v_rel=0.0, material=ICE, coeff_extra="frictionless",
@@ -78,14 +79,15 @@ def two_grain_scene(lmp, separation, v_rel=0.0, material=ICE, coeff_extra="frict
 
 
 def ledger(lmp):
-    """Energies at the current step: ke, erot, pe, the 12 values of compute pair
-    jkr/dt as p1..p12, 'dissipated' (slots 5-9) and 'total', the conserved sum."""
+    """Energies at the current step: ke, erot, pe, the values of compute pair jkr/dt by
+    their names (``jkrdt.ledger.VALUES``: U_n, U_s, ..., events, ..., contacts, made, cut),
+    'dissipated' (the channels) and 'total', the conserved sum."""
     p = lmp.numpy.extract_compute("p", 0, 1)
-    e = {f"p{k + 1}": float(p[k]) for k in range(12)}
+    e = {name: float(p[k]) for k, name in enumerate(jkrdt_ledger.VALUES)}
     e["ke"] = lmp.get_thermo("ke")
     e["pe"] = lmp.get_thermo("pe")
     e["erot"] = float(lmp.extract_compute("erot", 0, 0))
-    e["dissipated"] = sum(e[f"p{k}"] for k in range(5, 10))
+    e["dissipated"] = sum(e[name] for name in jkrdt_ledger.CHANNELS)
     e["total"] = e["ke"] + e["erot"] + e["pe"] + e["dissipated"]
     return e
 

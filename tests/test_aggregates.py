@@ -103,7 +103,7 @@ def test_lammps_reads_aggregates_at_rest_with_zero_force(tmp_path, dim):
             pair_coeff * * {pair_coeff(ICE)}
             neighbor 1e-8 bin
             compute p all pair jkr/dt
-            thermo_style custom step pe c_p[10]
+            thermo_style custom step pe
             run 0
         """)
         f = lmp.numpy.extract_atom("f")

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from conftest import ICE_SCALES as S, R_GRAIN as R
-from jkrdt import rundir
+from jkrdt import ledger, rundir
 from jkrdt import scene as scene_module
 from jkrdt.analysis import fragments as frag
 from jkrdt.analysis.dumps import frames, iter_local
@@ -44,8 +44,8 @@ def test_atom_dump_frames_through_mdanalysis(run):
     for f in seen:
         assert np.array_equal(f.ids, np.arange(1, 2 * N + 1))
         assert np.all(f.radius == R)
-        # the contact dump has exactly the bonded contacts the plugin counts (c_p[10])
-        assert len(f.pairs) == thermo["c_p[10]"][thermo["Step"] == f.step][0]
+        # the contact dump has exactly the bonded contacts the plugin counts
+        assert len(f.pairs) == thermo[ledger.CONTACTS][thermo["Step"] == f.step][0]
 
 
 def refines(fine, coarse):

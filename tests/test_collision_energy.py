@@ -46,9 +46,9 @@ def max_energy_error(history):
 def test_sticking_threshold_velocity():
     assert V_STICK / S.v0 == pytest.approx(1.9345, rel=1e-3)     # sqrt(3.742) v0
     stuck, _ = collide(0.97 * V_STICK, 0.005)
-    assert stuck[-1]["p10"] == 1
+    assert stuck[-1]["contacts"] == 1
     apart, _ = collide(1.03 * V_STICK, 0.005)
-    assert apart[-1]["p10"] == 0
+    assert apart[-1]["contacts"] == 0
 
 
 def test_rebound_speed_follows_the_energy_budget():
@@ -63,10 +63,10 @@ def test_losses_at_formation_and_separation_are_the_jumps_of_un():
     history, _ = collide(v, dt_over_tc)
     # a step meets each event up to v dt late: tolerance F_c v dt per event
     tolerance = 2 * S.F_c * v * dt_over_tc * S.t_c
-    formed = next(h for h in history if h["p10"] == 1)
-    assert formed["p5"] == pytest.approx(-U_TOUCH, abs=tolerance)
-    assert history[-1]["p10"] == 0
-    assert history[-1]["p5"] == pytest.approx(U_BREAK - U_TOUCH, abs=tolerance)
+    formed = next(h for h in history if h["contacts"] == 1)
+    assert formed["events"] == pytest.approx(-U_TOUCH, abs=tolerance)
+    assert history[-1]["contacts"] == 0
+    assert history[-1]["events"] == pytest.approx(U_BREAK - U_TOUCH, abs=tolerance)
     assert history[-1]["pe"] == 0.0
 
 
@@ -84,6 +84,6 @@ def test_energy_conserved_with_second_order_error(v_over_v0):
 def test_viscoelastic_damping_conserves_energy_and_makes_grains_stick():
     v = 3.0 * S.v0                   # bounces without damping (above V_STICK)
     history, _ = collide(v, 0.005, coeff_extra="frictionless tvis 6e-12")
-    assert history[-1]["p10"] == 1
-    assert history[-1]["p6"] > 0.5 * history[0]["ke"]
+    assert history[-1]["contacts"] == 1
+    assert history[-1]["damping"] > 0.5 * history[0]["ke"]
     assert max_energy_error(history) < 1e-4

@@ -28,8 +28,8 @@ def test_two_grains_make_one_contact_and_cut_it_only_above_the_sticking_speed(lm
     two_grain_scene(lmp, 2 * R_GRAIN + 0.5 * S.delta_c, v_rel=v_rel)
     lmp.command("run 30000")
     e = ledger(lmp)
-    assert (e["p11"], e["p12"]) == (made, cut)
-    assert e["p10"] == made - cut
+    assert (e["made"], e["cut"]) == (made, cut)
+    assert e["contacts"] == made - cut
 
 
 def test_a_contact_made_at_the_first_step_is_given_not_made(lmp):
@@ -38,7 +38,7 @@ def test_a_contact_made_at_the_first_step_is_given_not_made(lmp):
     two_grain_scene(lmp, 2 * R_GRAIN)
     lmp.command("run 1000")
     e = ledger(lmp)
-    assert (e["p10"], e["p11"], e["p12"]) == (1, 0, 0)
+    assert (e["contacts"], e["made"], e["cut"]) == (1, 0, 0)
 
 
 @pytest.mark.parametrize("ranks", [1, 2])

@@ -49,7 +49,7 @@ def test_twelve_contacts_on_one_grain(lmp):
         run 0
     """)
     e = ledger(lmp)
-    assert e["p10"] == 12
+    assert e["contacts"] == 12
     assert e["pe"] == pytest.approx(12 * U_EQUILIBRIUM, rel=1e-9)
     coord = lmp.numpy.extract_compute("coord", 1, 1)
     ids = lmp.numpy.extract_atom("id")

@@ -94,8 +94,8 @@ def test_collision_restructures_by_rolling(coarse_run):
     e = history[-1][0]
     e_imp = history[0][0]["ke"]
     # tangential dissipation dominates the normal one (Wada et al. 2007, Fig. 6)
-    assert e["p8"] > 0.1 * e_imp
-    assert e["p7"] + e["p8"] + e["p9"] > 3 * e["p5"]
+    assert e["rolling"] > 0.1 * e_imp
+    assert e["sliding"] + e["rolling"] + e["twisting"] > 3 * e["events"]
 
 
 def test_momentum_and_angular_momentum_conserved_to_round_off(coarse_run):
@@ -123,7 +123,7 @@ def test_2d_head_on_collision_stays_in_plane_and_conserves_energy(tmp_path):
     e = history[-1][0]
     assert np.allclose(final["rmass"], S.mass, rtol=1e-12)   # 2D grains keep the sphere's mass
     assert energy_error(history) < 1e-5
-    assert e["p8"] > 0.0                          # rolling acts in the plane
-    assert e["p9"] == 0.0 and e["p4"] == 0.0      # twisting vanishes in 2D
+    assert e["rolling"] > 0.0                          # rolling acts in the plane
+    assert e["twisting"] == 0.0 and e["U_t"] == 0.0      # twisting vanishes in 2D
     assert np.all(final["x"][:, 2] == 0.0) and np.all(final["v"][:, 2] == 0.0)
     assert np.all(final["omega"][:, :2] == 0.0)

@@ -32,3 +32,28 @@ def test_contact_kernel_checks(tmp_path):
     assert lines[-1] == "0 failed", run.stdout
     checks = [line for line in lines[:-1]]
     assert len(checks) == 30 and all(line.startswith("ok ") for line in checks), run.stdout
+
+
+def test_python_names_the_kernels_channels(tmp_path):
+    """The channels are declared once, in the kernel (JKRDT_NORMAL_CHANNELS and
+    JKRDT_TANGENTIAL_CHANNELS): the ledger's columns and compute pair jkr/dt's values, in
+    the order the compiled kernel gives them, are the names Python reads logs and sessions
+    by (jkrdt.ledger). A new channel is one line in the kernel and its name here."""
+    from jkrdt import ledger
+
+    source = tmp_path / "names.cpp"
+    source.write_text('#include "jkr_dt_contact.h"\n#include <cstdio>\n'
+                      'int main() {\n'
+                      '  for (const char *name : JKRDT::VALUE_NAME) std::puts(name);\n'
+                      '  std::printf("%d %d %d\\n", (int) JKRDT::NLOSS, (int) JKRDT::NCHANNEL,'
+                      ' (int) JKRDT::VALUE_LOSS);\n}\n')
+    exe = tmp_path / "names"
+    subprocess.run([compiler(), "-std=c++17", "-Wall", "-Werror", f"-I{ROOT / 'plugin'}",
+                    str(source), "-o", str(exe)], check=True)
+    *names, counts = subprocess.run([str(exe)], capture_output=True, text=True,
+                                    check=True).stdout.splitlines()
+    assert names == ledger.VALUES
+    nloss, nchannel, first_loss = map(int, counts.split())
+    assert names[first_loss:first_loss + nloss] == ledger.CHANNELS
+    assert len(ledger.POTENTIALS) == 1 + nchannel
+    assert ledger.LEDGER[0] == f"c_p[{first_loss + 1}]"

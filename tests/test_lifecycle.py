@@ -177,12 +177,12 @@ def test_switching_a_channel_off_books_its_springs_energy(lmp, switch):
     lmp.command("set atom 1 omega 2e6 1e6 3e6")
     lmp.command("run 300 post no")
     before = ledger(lmp)
-    assert before["p3"] > 0 and before["p4"] > 0            # U_r, U_t held
+    assert before["U_r"] > 0 and before["U_t"] > 0            # U_r, U_t held
     lmp.command(f"pair_coeff * * gamma 0.1 E 7e9 nu 0.25 {switch}")
     lmp.command("run 0 post no")
     after = ledger(lmp)
     assert after["total"] == pytest.approx(before["total"], rel=1e-12, abs=1e-12 * abs(before["pe"]))
-    for slot, ledger_slot in (("p2", "p7"), ("p3", "p8"), ("p4", "p9")):
+    for slot, ledger_slot in (("U_s", "sliding"), ("U_r", "rolling"), ("U_t", "twisting")):
         dropped = before[slot] - after[slot]                    # U_s, U_r, U_t that left pe
         assert after[ledger_slot] - before[ledger_slot] == pytest.approx(dropped, rel=1e-12,
                                                                          abs=1e-30)
@@ -196,18 +196,18 @@ def test_a_limit_lowered_between_runs_is_clamped_and_booked_by_the_next_step(lmp
     lmp.command("set atom 1 omega 0 0 3e6")
     lmp.command("run 300 post no")
     before = ledger(lmp)
-    xi = np.sqrt(2.0 * before["p3"] / S.k_r)                  # U_r = k_r xi^2 / 2, eq. (21)
-    assert before["p8"] == 0 and xi > 1e-10                    # held, never clamped
+    xi = np.sqrt(2.0 * before["U_r"] / S.k_r)                  # U_r = k_r xi^2 / 2, eq. (21)
+    assert before["rolling"] == 0 and xi > 1e-10                    # held, never clamped
     lmp.command(f"pair_coeff * * gamma 0.1 E 7e9 nu 0.25 xi_crit {xi / 4}")
     lmp.command("run 0 post no")
     setup = ledger(lmp)
-    assert setup["p3"] == before["p3"] and setup["p8"] == 0    # the set-up moved nothing
+    assert setup["U_r"] == before["U_r"] and setup["rolling"] == 0    # the set-up moved nothing
     lmp.command("run 1 pre no post no")
     after = ledger(lmp)
     # one step on, xi sits at the new limit: U_r = k_r (xi / 4)^2 / 2, and the rest of the
     # spring's energy is in the rolling channel (a step's rotation changes xi by 1e-4)
-    assert after["p3"] == pytest.approx(0.5 * S.k_r * (xi / 4) ** 2, rel=1e-3)
-    assert after["p8"] == pytest.approx(before["p3"] - after["p3"], rel=1e-2)
+    assert after["U_r"] == pytest.approx(0.5 * S.k_r * (xi / 4) ** 2, rel=1e-3)
+    assert after["rolling"] == pytest.approx(before["U_r"] - after["U_r"], rel=1e-2)
     assert after["total"] == pytest.approx(before["total"], rel=1e-9)
 
 
@@ -260,7 +260,7 @@ def test_renumbered_atoms_keep_their_contacts(renumber, ids_after):
     assert ids0 == [3, 2, 1] and ids1 == ids_after       # ordered by x
     # the pair continues exactly as without the renumbering: same grains, same state
     assert np.array_equal(x1[-2:], x0[-2:]) and np.array_equal(w1[-2:], w0[-2:])
-    assert e1["p10"] == e0["p10"] == 1
+    assert e1["contacts"] == e0["contacts"] == 1
 
 
 def test_delete_atoms_compress_yes_carries_the_survivors_contacts(lmp):
@@ -299,10 +299,10 @@ def test_a_channel_switched_off_across_a_pair_style_swap_is_booked(lmp):
     lmp.command("pair_coeff * * gamma 0.1 E 7e9 nu 0.25 frictionless")
     lmp.command("run 0 post no")
     after = ledger(lmp)
-    held = before["p2"] + before["p3"] + before["p4"]
-    assert held > 0 and after["p2"] == after["p3"] == after["p4"] == 0
+    held = before["U_s"] + before["U_r"] + before["U_t"]
+    assert held > 0 and after["U_s"] == after["U_r"] == after["U_t"] == 0
     assert after["total"] == pytest.approx(before["total"], rel=1e-12)
-    booked = sum(after[k] - before[k] for k in ("p7", "p8", "p9"))
+    booked = sum(after[k] - before[k] for k in ("sliding", "rolling", "twisting"))
     assert booked == pytest.approx(held, rel=1e-12)
 
 
@@ -342,11 +342,11 @@ def test_a_channel_switched_off_across_a_restart_is_booked(tmp_path, switch):
         first.command(f"write_restart {tmp_path}/loaded.restart")
     finally:
         first.close()
-    assert before["p2"] > 0 and before["p3"] > 0 and before["p4"] > 0
+    assert before["U_s"] > 0 and before["U_r"] > 0 and before["U_t"] > 0
     after = read_and_switch(tmp_path / "loaded.restart", switch)
     assert after["total"] == pytest.approx(before["total"], rel=1e-12,
                                            abs=1e-12 * abs(before["pe"]))
-    for slot, ledger_slot in (("p2", "p7"), ("p3", "p8"), ("p4", "p9")):
+    for slot, ledger_slot in (("U_s", "sliding"), ("U_r", "rolling"), ("U_t", "twisting")):
         dropped = before[slot] - after[slot]                    # U_s, U_r, U_t that left pe
         assert after[ledger_slot] - before[ledger_slot] == pytest.approx(dropped, rel=1e-12,
                                                                          abs=1e-30)
@@ -362,8 +362,8 @@ def test_a_restart_file_with_made_with_as_bytes_still_books_a_channel_switched_o
     after = read_and_switch(data / "made_with_as_bytes.restart", switch)
     assert after["total"] == pytest.approx(before["total"], rel=1e-12,
                                            abs=1e-12 * abs(before["pe"]))
-    booked = sum(after[k] - before[k] for k in ("p7", "p8", "p9"))
-    held = sum(before[k] - after[k] for k in ("p2", "p3", "p4"))
+    booked = sum(after[k] - before[k] for k in ("sliding", "rolling", "twisting"))
+    held = sum(before[k] - after[k] for k in ("U_s", "U_r", "U_t"))
     assert held > 0 and booked == pytest.approx(held, rel=1e-12)
 
 

@@ -23,7 +23,7 @@ def test_rest_at_equilibrium_has_no_force_and_energy_u_delta0(lmp):
     # round-off of delta: |x| ~ 2e-7 m carries ~3e-23 m error against delta0 ~ 1e-9 m
     assert abs(atom_force_x(lmp, 1)) < 1e-11 * S.F_c
     assert e["pe"] / (S.F_c * S.delta_c) == pytest.approx(U_EQUILIBRIUM, rel=1e-10)
-    assert e["p10"] == 1
+    assert e["contacts"] == 1
 
 
 def test_force_follows_eq5_over_compression_and_tensile_branch(lmp):
@@ -47,19 +47,19 @@ def test_tensile_force_at_break_point_and_break_beyond(lmp):
     place(lmp, -(1 - 1e-9) * S.delta_c)
     # at a/a0 = 6^(-2/3): F = 4 (1/36 - 1/6) F_c = -5/9 F_c
     assert -atom_force_x(lmp, 1) == pytest.approx(-5 / 9 * S.F_c, rel=1e-4)
-    assert ledger(lmp)["p10"] == 1
+    assert ledger(lmp)["contacts"] == 1
     place(lmp, -(1 + 1e-9) * S.delta_c)
     assert atom_force_x(lmp, 1) == 0.0
-    assert ledger(lmp)["p10"] == 0
+    assert ledger(lmp)["contacts"] == 0
     assert ledger(lmp)["pe"] == 0.0
     place(lmp, -0.5 * S.delta_c)                           # no re-forming while apart
-    assert atom_force_x(lmp, 1) == 0.0 and ledger(lmp)["p10"] == 0
+    assert atom_force_x(lmp, 1) == 0.0 and ledger(lmp)["contacts"] == 0
 
 
 def test_no_contact_before_touching(lmp):
     two_grain_scene(lmp, 2 * R_GRAIN + 0.5 * S.delta_c)
     lmp.command("run 0")
-    assert atom_force_x(lmp, 1) == 0.0 and ledger(lmp)["p10"] == 0
+    assert atom_force_x(lmp, 1) == 0.0 and ledger(lmp)["contacts"] == 0
 
 
 def test_breaking_energy_from_plugin_energies_is_eq45(lmp):
@@ -149,4 +149,4 @@ def test_damping_force_is_eq_A5_and_off_under_tension_with_damp_tension_off(lmp,
     assert f_d == 0.0 or f_d > 0.05 * S.F_c                # a force the comparison resolves
     assert -atom_force_x(lmp, 1) == pytest.approx(jkr_force(delta, S) - f_d, rel=1e-9,
                                                   abs=1e-10 * S.F_c)
-    assert ledger(lmp)["p10"] == 1
+    assert ledger(lmp)["contacts"] == 1

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from jkrdt import rundir
+from jkrdt import ledger, rundir
 from jkrdt.analysis.tables import read_csv
 from jkrdt.materials import ICE
 from jkrdt.scene import Scene
@@ -57,10 +57,10 @@ def test_a_balanced_restart_with_departed_fragments_reads_on_any_rank_count(tmp_
         out = tmp_path / f"on{ranks}"
         thermo = deck_run(scene, out, ranks, steps=2000, every=1000,
                           **rundir.continuation(restart))
-        # nothing lost at the read: the bonded contacts (c_p[10]) and the departed
+        # nothing lost at the read: the bonded contacts and the departed
         # fragments' energy (c_kedep, still the same grains) as the run left them
         assert thermo["Step"][0] == 24000
-        assert thermo["c_p[10]"][0] == checks[-1]["contacts"]
+        assert thermo[ledger.CONTACTS][0] == checks[-1]["contacts"]
         assert thermo["c_kedep"][0] == pytest.approx(thermo_last(first)["c_kedep"],
                                                      rel=1e-12)
         rows = read_csv(out / rundir.CHECKS)

@@ -17,7 +17,7 @@ from conftest import R_GRAIN, ledger, two_grain_scene
 from jkrdt.aggregates import bpca
 from jkrdt.datafile import write_sphere_data
 from jkrdt.materials import ICE, QUARTZ, scales
-from jkrdt.ledger import CONSERVED
+from jkrdt.ledger import CONSERVED, FIRST_CHANNEL, LEDGER
 from jkrdt.scene import pair_coeff
 from jkrdt.session import read_deck, start_lammps
 
@@ -48,7 +48,7 @@ def head_on(v_over_v0, dt_over_tc=0.014, material=ICE, radius=R_GRAIN, duration_
         for _ in range(0, steps, chunk):
             lmp.command(f"run {chunk} pre no post no")
             worst = max(worst, abs(ledger(lmp)["total"] - e0) / k0)
-        return relative_speed(lmp) / s.v0, worst, ledger(lmp)["p10"]
+        return relative_speed(lmp) / s.v0, worst, ledger(lmp)["contacts"]
     finally:
         lmp.close()
 
@@ -172,13 +172,13 @@ def test_deep_but_physical_overlap_flies_apart_with_the_energy_kept(lmp):
     # 20 delta0 of compression: U_n(delta) goes into motion, ke + pe stays put
     s = scales(ICE, R_GRAIN)
     grains(lmp, 2 * R_GRAIN - 20 * s.delta0, skin=1e-8)
-    lmp.commands_string("compute p all pair jkr/dt\nthermo_style custom step ke pe c_p[5]\n"
+    lmp.commands_string(f"compute p all pair jkr/dt\nthermo_style custom step ke pe {LEDGER[0]}\n"
                         "run 0 post no")
     e0 = lmp.get_thermo("ke") + lmp.get_thermo("pe")
     u0 = -lmp.get_thermo("pe")
     lmp.command("run 20000 post no")
     e1 = lmp.get_thermo("ke") + lmp.get_thermo("pe") + float(
-        lmp.numpy.extract_compute("p", 0, 1)[4])
+        lmp.numpy.extract_compute("p", 0, 1)[FIRST_CHANNEL])
     assert lmp.get_thermo("ke") > 0.5 * abs(u0)           # the stored energy became motion
     assert abs(e1 - e0) < 1e-3 * abs(u0)
 

@@ -85,16 +85,16 @@ def test_rolling_a_quarter_turn_dissipates_E_roll(lmp, kr_scale):
         e = ledger(lmp)
         angle = math.acos(np.clip(np.dot(n0, normal(lmp)), -1, 1))
         if angle > 0.2:
-            u_r_plateau.append(e["p3"])
+            u_r_plateau.append(e["U_r"])
     # rolling without slip turns n1 by 2 angle: the xi path is 2 R angle, of which
     # the first xi_crit is elastic (eqs. 40, 44)
     expected = k_r * XI_CRIT * (2 * S.R * angle - XI_CRIT)
-    print(f"rolled {math.degrees(angle):.2f} deg: E_dis,r = {e['p8'] / e_roll:.4f} E_roll")
-    assert e["p8"] == pytest.approx(expected, rel=2e-3)
-    assert e["p8"] == pytest.approx(e_roll, rel=0.02)
+    print(f"rolled {math.degrees(angle):.2f} deg: E_dis,r = {e['rolling'] / e_roll:.4f} E_roll")
+    assert e["rolling"] == pytest.approx(expected, rel=2e-3)
+    assert e["rolling"] == pytest.approx(e_roll, rel=0.02)
     # the rolling spring sits at its limit, U_r = k_r xi_crit^2 / 2; sliding stays elastic
     assert np.allclose(u_r_plateau, 0.5 * k_r * XI_CRIT ** 2, rtol=2e-3)
-    assert abs(e["p7"]) < 1e-6 * e["p8"] and e["p9"] == 0.0
+    assert abs(e["sliding"]) < 1e-6 * e["rolling"] and e["twisting"] == 0.0
     assert abs(e["total"] - start["total"]) < 1e-6 * start["ke"]
 
 
@@ -109,7 +109,7 @@ def test_sliding_force_saturates_at_eq35(lmp):
         f2 = atom_row(lmp, "f", 2)
         n = normal(lmp)
         loads.append(np.linalg.norm(f2 - np.dot(f2, n) * n))
-        u_s.append(ledger(lmp)["p2"])
+        u_s.append(ledger(lmp)["U_s"])
         zeta.append(lmp.numpy.extract_compute("bonds", 2, 2)[0, 5])
     e = ledger(lmp)
     # eq. (14): k_s zeta_crit times (r1 + r2 - zeta0.n_c) / |x1 - x2| = 2 r / (2 r - delta0)
@@ -118,8 +118,8 @@ def test_sliding_force_saturates_at_eq35(lmp):
     assert max(zeta) == pytest.approx(ZETA_CRIT, rel=1e-6)           # clamped by eq. (42)
     assert max(u_s) == pytest.approx(0.5 * K_S * ZETA_CRIT ** 2, rel=1e-6)
     # the kinetic energy went into sliding, none into rolling or twisting
-    assert e["p7"] > 0.95 * start["ke"]
-    assert e["p8"] == 0.0 and e["p9"] == 0.0
+    assert e["sliding"] > 0.95 * start["ke"]
+    assert e["rolling"] == 0.0 and e["twisting"] == 0.0
     assert abs(e["total"] - start["total"]) < 1e-5 * start["ke"]
 
 
@@ -136,8 +136,8 @@ def test_twisting_torque_saturates_at_eq37(lmp):
     assert max(torques) == pytest.approx(M_FRIC, rel=1e-9)
     phi = lmp.numpy.extract_compute("bonds", 2, 2)[0, 7]
     assert abs(phi) <= PHI_CRIT * (1 + 1e-12)
-    assert e["p9"] > 0.95 * (start["erot"])
-    assert e["p7"] == 0.0 and e["p8"] == 0.0
+    assert e["twisting"] > 0.95 * (start["erot"])
+    assert e["sliding"] == 0.0 and e["rolling"] == 0.0
     assert abs(e["total"] - start["total"]) < 1e-6 * start["erot"]
 
 
@@ -158,7 +158,7 @@ def oscillate(dt_over_tc, duration_tc=60.0):
         for _ in range(200):
             lmp.command(f"run {steps // 200} pre no post no")
             e = ledger(lmp)
-            peak = np.maximum(peak, [e["p2"], e["p3"], e["p4"]])
+            peak = np.maximum(peak, [e["U_s"], e["U_r"], e["U_t"]])
             drift = max(drift, abs(e["total"] - start["total"]))
     finally:
         lmp.close()
@@ -172,7 +172,7 @@ def test_small_oscillations_are_elastic_and_conserve_energy():
     print(f"peak U_s, U_r, U_t / E_in = {peak}; max |dE| / E_in = {coarse:.2e} (0.014 t_c), "
           f"{fine:.2e} (0.005 t_c)")
     assert np.all(peak > 0.05)                        # all three springs take part
-    assert e["p7"] == e["p8"] == e["p9"] == 0.0       # no clamp, no dissipation
+    assert e["sliding"] == e["rolling"] == e["twisting"] == 0.0       # no clamp, no dissipation
     # the stiffest mode (sliding against spin) has omega dt = 0.037 at 0.014 t_c, so
     # velocity Verlet's energy wobbles by ~(omega dt)^2 / 8 = 1.7e-4; it is second order
     assert coarse < 3e-4

@@ -41,7 +41,7 @@ import numpy as np
 
 from common import campaign_study_parser, run_campaigns, save as save_figure, study_paths
 from jkrdt.analysis.tables import write_csv
-from jkrdt import rundir
+from jkrdt import ledger, rundir
 
 #: Table 3 of the paper: (material preset, xi_crit)
 SETS = {"quartz 2A": ("quartz", 2e-10), "quartz 30A": ("quartz", 30e-10),
@@ -136,8 +136,8 @@ def by_speed(rows: list[dict], name: str):
     for u in speeds:
         at = [r for r in mine if round(r["v_over_v0"], 9) == u]
         out.append({k: float(np.mean([r[k] for r in at])) for k in
-                    ("x", "y", "rg_over_r1_sqrt_Nlar", "n_con", "N_lar_over_N", "share_rolling",
-                     "share_sliding", "share_events", "share_damping", "share_twisting")}
+                    ("x", "y", "rg_over_r1_sqrt_Nlar", "n_con", "N_lar_over_N",
+                     *(f"share_{c}" for c in ledger.CHANNELS))}
                    | dict(v_over_v0=u, runs=len(at),
                           n_con_sd=float(np.std([r["n_con"] for r in at]))))
     return out
@@ -189,9 +189,7 @@ def compare(plan: dict, rows: list[dict]) -> dict:
                                 "rg_over_r1_sqrt_Nlar", eq51, 0.0, 0.1)["ratio_mean"],
             eq56_ratio=relation([r for r in good if r["set"] == name], n_k, "n_con", eq56, 1.0,
                                 0.1)["ratio_mean"],
-            shares_at_maximum_compression={k: top[f"share_{k}"] for k in
-                                           ("rolling", "sliding", "events", "damping",
-                                            "twisting")},
+            shares_at_maximum_compression={k: top[f"share_{k}"] for k in ledger.CHANNELS},
             largest_rolling_share=max(c["share_rolling"] for c in curve))
     out["sets"] = sets
     return out
@@ -274,7 +272,7 @@ def figures(plan: dict, rows: list[dict], results: Path) -> list[Path]:
     for ax, name in zip(axes[0], plan["sets"]):
         curve = by_speed(rows, name)
         x = [c["x"] for c in curve]
-        for k in ("rolling", "sliding", "events", "damping", "twisting"):
+        for k in ledger.CHANNELS:
             share = [c[f"share_{k}"] for c in curve]
             if max(share) > 0.005:
                 ax.semilogx(x, share, "o-", ms=3, label=k)

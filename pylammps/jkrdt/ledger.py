@@ -1,7 +1,7 @@
 """The energy ledger: the layout of ``compute pair jkr/dt``'s vector, the thermo line that
 carries it, and the energy budget a run conserves.
 
-The plugin's compute gives 12 values (its manual page, "Output"):
+The plugin's compute gives these values (``VALUES``; its manual page, "Output"):
 
     1-4   U_n, U_s, U_r, U_t: the normal, sliding, rolling and twisting potentials
     5-9   energy dissipated by contact formation and breaking ('events'), damping,
@@ -11,7 +11,9 @@ The plugin's compute gives 12 values (its manual page, "Output"):
           3D BPCA paper, App. C.2); contacts present at the first step count as neither,
           so value 10 = its first value + N_con - N_cut, exactly
 
-ke + erotate/sphere + pe + values 5-9 is conserved. The deck's computes kedep and erotdep
+ke + erotate/sphere + pe + the channels is conserved. The channels are declared once, in
+the kernel (plugin/jkr_dt_contact.h and jkr_dt_tangential.h); this module gives their
+names to Python, and a test holds the two lists equal. The deck's computes kedep and erotdep
 are the part of ke and erotate that fragments which have departed (``jkrdt.stopping``)
 carry away: constant once they are gone, like their contacts' share of pe.
 
@@ -24,23 +26,32 @@ from __future__ import annotations
 
 import numpy as np
 
-#: the dissipation channels, in the order of values 5-9 of compute pair jkr/dt
+#: the dissipation channels: the kernel's ledger columns (plugin/jkr_dt_contact.h: its
+#: JKRDT_NORMAL_CHANNELS, then its JKRDT_TANGENTIAL_CHANNELS), which tests/test_structure.py
+#: compares with these
 CHANNELS = ["events", "damping", "sliding", "rolling", "twisting"]
+#: the contact potentials: U_n, then one per tangential channel
+POTENTIALS = ["U_n", "U_s", "U_r", "U_t"]
+#: compute pair jkr/dt's values in order (the kernel's VALUE_NAME): the potentials, the
+#: channels, the bonded contacts, the contacts made and cut
+VALUES = [*POTENTIALS, *CHANNELS, "contacts", "made", "cut"]
 #: 0-based index of the first channel, of the contact count and of N_con, N_cut in the
 #: compute's vector
-FIRST_CHANNEL, CONTACT_COUNT, EVENT_COUNTS = 4, 9, (10, 11)
+FIRST_CHANNEL, CONTACT_COUNT = VALUES.index(CHANNELS[0]), VALUES.index("contacts")
+EVENT_COUNTS = (VALUES.index("made"), VALUES.index("cut"))
 #: the compute's values as thermo names (the deck's compute is called p)
 LEDGER = [f"c_p[{FIRST_CHANNEL + 1 + k}]" for k in range(len(CHANNELS))]
 CONTACTS = f"c_p[{CONTACT_COUNT + 1}]"
 #: N_con, N_cut as thermo names; a log written before they were counted lacks them
 MADE, CUT = (f"c_p[{k + 1}]" for k in EVENT_COUNTS)
-#: the deck's thermo keywords and the names LAMMPS gives their columns in a log
 #: the kinetic and rotational energy of the departed fragments (included in ke, c_erot)
 DEPARTED = ["c_kedep", "c_erotdep"]
-THERMO_KEYWORDS = ["step", "time", "ke", "c_erot", "pe", *LEDGER, CONTACTS, *DEPARTED,
-                   MADE, CUT]
-THERMO = ["Step", "Time", "KinEng", "c_erot", "PotEng", *LEDGER, CONTACTS, *DEPARTED,
-          MADE, CUT]
+#: the deck's thermo keywords (all the compute's values, c_p[*]) and the names LAMMPS gives
+#: their columns in a log. Logs of decks before 2026-12-07 hold c_p[5]-c_p[12] alone, in
+#: another order: they are read by these names, never by position
+THERMO_KEYWORDS = ["step", "time", "ke", "c_erot", "pe", "c_p[*]", *DEPARTED]
+THERMO = ["Step", "Time", "KinEng", "c_erot", "PotEng",
+          *(f"c_p[{k + 1}]" for k in range(len(VALUES))), *DEPARTED]
 THERMO_STYLE = "thermo_style    custom " + " ".join(THERMO_KEYWORDS)
 #: the conserved total as a LAMMPS equal-style formula over the deck's computes p, erot
 CONSERVED = "ke+c_erot+pe+" + "+".join(LEDGER)
@@ -52,10 +63,8 @@ def sample(lmp) -> list[float]:
     p = lmp.numpy.extract_compute("p", 0, 1)
     return [lmp.get_thermo("step"), lmp.get_thermo("time"), lmp.get_thermo("ke"),
             float(lmp.extract_compute("erot", 0, 0)), lmp.get_thermo("pe"),
-            *(float(p[FIRST_CHANNEL + k]) for k in range(len(CHANNELS))),
-            float(p[CONTACT_COUNT]),
-            *(float(lmp.extract_compute(name[2:], 0, 0)) for name in DEPARTED),
-            *(float(p[k]) for k in EVENT_COUNTS)]
+            *(float(p[k]) for k in range(len(VALUES))),
+            *(float(lmp.extract_compute(name[2:], 0, 0)) for name in DEPARTED)]
 
 
 def energy_budget(thermo: dict[str, np.ndarray]) -> dict[str, np.ndarray]:

@@ -151,7 +151,7 @@ static void clamps()
     close("eqs. (14), (35): sliding force at F_fric", std::hypot(out.F1.y, out.F1.z), F, 1e-5 * F);
     // nothing moved in the step: what the clamp dissipated is what the spring lost
     const double lost = 0.5 * c.K.k_s * (zeta_before * zeta_before - zeta * zeta);
-    close("sliding loss of the clamp = drop of U_s", out.loss[LOSS_SLIDING], lost, 1e-9 * lost);
+    close("sliding loss of the clamp = drop of U_s", out.loss[LOSS_SLIDE], lost, 1e-9 * lost);
   }
   // rolling: the pointers tilted the same way by t: xi = R (n1 + n2) = 1.01 xi_crit, zeta = 0
   {
@@ -194,8 +194,8 @@ static void setup_changes_nothing()
   for (int k = 3; k < 6; k++) s[k] /= std::sqrt(1.0 + 1.09 * t2 * t2);
   ContactResult step, again;
   contact_step(c, FULL, m, delta, 1e-12, false, false, true, s, step);
-  check(step.loss[LOSS_SLIDING] > 0.0 && step.loss[LOSS_ROLLING] > 0.0, "the step clamped "
-        "sliding and rolling (their losses > 0)", step.loss[LOSS_SLIDING], 0.0, 0.0);
+  check(step.loss[LOSS_SLIDE] > 0.0 && step.loss[LOSS_ROLL] > 0.0, "the step clamped "
+        "sliding and rolling (their losses > 0)", step.loss[LOSS_SLIDE], 0.0, 0.0);
   double stored[7];
   std::copy(s, s + 7, stored);
   contact_step(c, FULL, m, delta, 1e-12, true, false, true, s, again);
@@ -369,8 +369,8 @@ static void lanes_equal_one_contact()
       contact_step(c, L, m[e], delta[e], dt, false, false, true, laned[e], four[e]);
     else
       contact_normal_part(c, L, m[e], delta[e], dt, false, false, true, laned[e], four[e]);
-    clamped += one[e].lossy && one[e].loss[LOSS_SLIDING] + one[e].loss[LOSS_ROLLING] +
-        one[e].loss[LOSS_TWISTING] != 0.0;
+    clamped += one[e].lossy && one[e].loss[LOSS_SLIDE] + one[e].loss[LOSS_ROLL] +
+        one[e].loss[LOSS_TWIST] != 0.0;
     fast += e % 7 == 0;
   }
   int count = 0;
