@@ -583,9 +583,7 @@ def negative_values_joined(argv: list[str]) -> list[str]:
     return out
 
 
-def main(argv=None) -> int:
-    parser = ArgumentParser(prog="jkrdt", description=__doc__)
-    sub = parser.add_subparsers(dest="command", required=True)
+def _arguments_demo(sub) -> None:
     d = sub.add_parser("demo", help="collide two BPCA ice aggregates and report the outcome")
     d.add_argument("--n", type=int, default=500, help="grains per aggregate")
     d.add_argument("--v", type=float, default=20.0, help="collision speed, m/s")
@@ -601,6 +599,9 @@ def main(argv=None) -> int:
                    help="viscoelastic time of eq. (A.5), s (the paper's 6 ps: 6e-12)")
     d.add_argument("--seed", type=int, default=1)
     d.add_argument("--out", default="runs/demo")
+
+
+def _arguments_setup(sub) -> None:
     st = sub.add_parser("setup", help="build two aggregates and write a collision scene")
     st.add_argument("--kind", choices=list(BUILDERS), default="bpca")
     st.add_argument("--dim", type=int, choices=[2, 3], default=3)
@@ -625,6 +626,9 @@ def main(argv=None) -> int:
                     help="neighbor skin, m (default: 1e-8, or 8 v_col dt where grains move "
                          "farther in a step: large grains, fast collisions)")
     st.add_argument("--out", default="runs/scene")
+
+
+def _arguments_build(sub) -> None:
     bd = sub.add_parser("build", help="build one aggregate and write it as a data file")
     bd.add_argument("--kind", choices=list(BUILDERS), default="bpca")
     bd.add_argument("--dim", type=int, choices=[2, 3], default=3)
@@ -632,6 +636,9 @@ def main(argv=None) -> int:
     bd.add_argument("--seed", type=int, default=1)
     bd.add_argument("--out", default="runs/aggregate")
     add_material_options(bd)
+
+
+def _arguments_run(sub) -> None:
     rn = sub.add_parser("run", help="run a scene written by 'jkrdt setup'")
     rn.add_argument("dir", help="directory with collision.data and collision.json")
     add_settle_options(rn)
@@ -646,6 +653,9 @@ def main(argv=None) -> int:
     rn.add_argument("--force", action="store_true",
                     help="run a finished run again from the start, replacing its record (a "
                          "run that was cut off continues without it)")
+
+
+def _arguments_analyse(sub) -> None:
     an = sub.add_parser("analyse", help="outcome of a run directory: metrics per frame, "
                         "outcome.json, frames.csv, pictures")
     an.add_argument("dir")
@@ -655,6 +665,9 @@ def main(argv=None) -> int:
     an.add_argument("--no-plots", action="store_true")
     an.add_argument("--partial", action="store_true",
                     help="analyse a run that failed or was cut off, as far as its dumps go")
+
+
+def _arguments_campaign(sub) -> None:
     cp = sub.add_parser("campaign", help="run a grid of collisions from a JSON spec "
                         "(resumes: finished runs are skipped)",
                         description=campaign_module.__doc__)
@@ -672,19 +685,40 @@ def main(argv=None) -> int:
                          "start afresh")
     cp.add_argument("--retry-failed", action="store_true",
                     help="run the runs that failed again, from the start")
+
+
+def _arguments_summarise(sub) -> None:
     sm = sub.add_parser("summarise", help="B_off-weighted statistics of a campaign: "
                         "runs.csv, summary.csv, summary.json, plots")
     sm.add_argument("dir")
     sm.add_argument("--no-plots", action="store_true")
     sm.add_argument("--include-cap", action="store_true",
                     help="average in the runs that hit the settle cap (left out by default)")
-    parser.add_argument("--debug", action="store_true",
-                        help="show the Python traceback of an error instead of one line")
+
+#: the commands: their arguments, and what runs them
+COMMANDS = {"demo": (_arguments_demo, demo), "setup": (_arguments_setup, setup),
+            "build": (_arguments_build, build), "run": (_arguments_run, run),
+            "analyse": (_arguments_analyse, analyse),
+            "campaign": (_arguments_campaign, campaign),
+            "summarise": (_arguments_summarise, summarise)}
+
+
+def parser() -> ArgumentParser:
+    """jkrdt's command line: a sub-command each of COMMANDS."""
+    top = ArgumentParser(prog="jkrdt", description=__doc__)
+    sub = top.add_subparsers(dest="command", required=True)
+    for arguments, _ in COMMANDS.values():
+        arguments(sub)
+    top.add_argument("--debug", action="store_true",
+                     help="show the Python traceback of an error instead of one line")
+    return top
+
+
+def main(argv=None) -> int:
     words = negative_values_joined(sys.argv[1:] if argv is None else [str(a) for a in argv])
-    args = parser.parse_args(words)
+    args = parser().parse_args(words)
     args.argv = words
-    command = {"demo": demo, "build": build, "setup": setup, "run": run, "analyse": analyse,
-               "campaign": campaign, "summarise": summarise}[args.command]
+    command = COMMANDS[args.command][1]
     try:
         return command(args)
     except SystemExit as stop:           # the commands' own one-line errors
