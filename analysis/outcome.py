@@ -134,6 +134,10 @@ class CollisionOutcome(AnalysisBase):
     analysis at the frame before it; ``results.cut_off_at`` is then that frame's step."""
 
     MEASURES = [f.name for f in dataclasses.fields(Outcome)]
+    #: each measure's array type: the results are allocated for every frame at the start,
+    #: as MDAnalysis's own analyses do, and cut to the frames measured at the end
+    DTYPES = {f.name: np.int64 if f.type == "int" else np.float64
+              for f in dataclasses.fields(Outcome)}
 
     def __init__(self, universe, n_target: int, n_projectile: int, contacts=None,
                  tolerance: float | None = None, **kwargs):
@@ -151,7 +155,8 @@ class CollisionOutcome(AnalysisBase):
 
     def _prepare(self):
         for name in self.MEASURES:
-            self.results[name] = []
+            self.results[name] = np.zeros(self.n_frames, dtype=self.DTYPES[name])
+        self._measured = 0    # frames measured: all but those after a cut-off snapshot
         self.results.cut_off_at = None
         self.results.types = self._atoms.types[self._order].astype(int)
         self._last = None
@@ -175,7 +180,8 @@ class CollisionOutcome(AnalysisBase):
                       pairs=pairs)
         labels, outcome = measure_frame(frame, *self._n, self._tolerance)
         for name in self.MEASURES:
-            self.results[name].append(getattr(outcome, name))
+            self.results[name][self._frame_index] = getattr(outcome, name)
+        self._measured = self._frame_index + 1
         if self._last is None:
             self.results.first_positions = frame.x
         from .dumps import DEPARTED_AT
@@ -187,7 +193,7 @@ class CollisionOutcome(AnalysisBase):
 
     def _conclude(self):
         for name in self.MEASURES:
-            self.results[name] = np.asarray(self.results[name])
+            self.results[name] = self.results[name][:self._measured]
         if self._last is not None:
             frame, labels, self.results.departed_at, self.results.velocities = self._last
             sizes, cumulative = frag.cumulative_number(labels)

@@ -109,8 +109,8 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
                     row.update(N_con=events["N_con"], N_cut=events["N_cut"])
     # the outcome: at the last atom frame, or at the last check after it (a partial one)
     last_step = max(last_frame, int(rows[-1]["step"]))
-    final = dumped[-1] if last_step == last_frame else \
-        {name: rows[-1][name] for name in CollisionOutcome.MEASURES}
+    final = {name: (dumped[-1] if last_step == last_frame else rows[-1])[name]
+             for name in CollisionOutcome.MEASURES}
     if status.stop_reason != IN_PROGRESS:
         status = run_status(run, last_dump_step=last_frame, text=text)
     if status.problem and not partial:

@@ -93,3 +93,28 @@ def test_the_layout_page_names_every_source_file():
                and not any(fnmatch.fnmatch(str(p.relative_to(ROOT)), n)
                            or fnmatch.fnmatch(p.name, n) for n in named)]
     assert not missing, f"docs/layout.md does not say what these are: {missing}"
+
+
+def test_rundir_declares_every_field_of_outcome_json_and_the_manual_names_them():
+    """outcome.json's schema is written once (jkrdt.rundir.OUTCOME_FIELDS): the manual's
+    page of records names exactly those fields (the parameters' paragraph and the first
+    column of the table), the outcome's measures are among them, and a field not declared
+    is refused when the record is written."""
+    from jkrdt import rundir
+    from jkrdt.analysis.outcome import Outcome
+    import dataclasses
+    import pytest
+
+    page = (ROOT / "docs" / "records.md").read_text()
+    section = page[page.index("### `outcome.json`"):page.index("An `outcome.json` whose")]
+    opening = section[section.index("The run's parameters open it"):
+                      section.index("A failed run adds")]
+    named = [n for n in re.findall(r"`([A-Za-z_0-9]+)`", opening)]
+    for row in section.splitlines():
+        if row.startswith("| `"):
+            named += re.findall(r"`([A-Za-z_0-9]+)`", row.split("|")[1])
+    assert named[:len(rundir.PARAMETER_FIELDS)] == list(rundir.PARAMETER_FIELDS)
+    assert sorted(named) == sorted(rundir.OUTCOME_FIELDS)
+    assert {f.name for f in dataclasses.fields(Outcome)} <= set(rundir.ANALYSIS_FIELDS)
+    with pytest.raises(ValueError, match="declare it in jkrdt.rundir.OUTCOME_FIELDS"):
+        rundir.write_outcome(ROOT / "no-such-run", {"run": "x", "speed_of_light": 3e8})

@@ -344,16 +344,38 @@ def run_status(run, last_dump_step: int | None = None, text: str | None = None) 
 
 
 # ---- outcome.json --------------------------------------------------------------------
+#: the fields of ``outcome.json``, in the order it holds them; docs/records.md says what
+#: each is (a test holds the page to these lists). The run's parameters open it, for a
+#: failed run too (``parameters``) ...
+PARAMETER_FIELDS = ("run", "N_tar", "N_pro", "v_col", "B_off", "seed", "model", "kind",
+                    "dimension", "material", "xi_crit", "tvis", "radius")
+#: ... then what ``jkrdt analyse`` (``analysis/run.py``) adds: the energy scales, the
+#: outcome (the measures of ``analysis.outcome.Outcome``) and its fragments, how the run
+#: ended, the energy partition, the contact counts, the pictures and the paper's diagnostics
+ANALYSIS_FIELDS = ("E_imp", "n_k", "E_roll", "E_break", "E_imp_over_nk_Eroll",
+                   "E_imp_over_nk_Ebreak", "step", "n_total", "n_largest", "n_second",
+                   "n_fragments", "growth_efficiency", "gyration_radius_largest",
+                   "contacts_per_particle", "fragment_sizes", "N_cum", "contacts_source",
+                   "stop_reason", "stop_step", "last_step", "last_frame_step", "outcome_from",
+                   "settled", "problem", "time_end", "time_end_over_tc", "kinetic_start",
+                   "kinetic_left", "kinetic_departed", "potential_change", "energy_drift",
+                   "energy_error", "energy_warning", "dissipated_fraction",
+                   "dissipated_by_channel", "N_con", "N_cut", "contacts_start",
+                   "contacts_end", "pictures", "diagnostics")
+OUTCOME_FIELDS = PARAMETER_FIELDS + ANALYSIS_FIELDS
+
+
 def parameters(directory, meta: dict | None = None) -> dict:
     """The fields that open every ``outcome.json``, of a finished run or a failed one: the
     run and the parameters of its scene."""
     meta = read_metadata(directory) if meta is None else meta
     mat = meta["material"]
-    return dict(run=str(directory), N_tar=meta["N_tar"], N_pro=meta["N_pro"],
-                v_col=meta["v_col"], B_off=meta["B_off"], seed=meta.get("seed"),
-                model=meta.get("model") or "frictional", kind=meta.get("kind") or "bpca",
-                dimension=meta["dimension"], material=mat["name"], xi_crit=mat.get("xi_crit"),
-                tvis=mat.get("tvis", 0.0), radius=meta["radius"])
+    values = dict(run=str(directory), N_tar=meta["N_tar"], N_pro=meta["N_pro"],
+                  v_col=meta["v_col"], B_off=meta["B_off"], seed=meta.get("seed"),
+                  model=meta.get("model") or "frictional", kind=meta.get("kind") or "bpca",
+                  dimension=meta["dimension"], material=mat["name"],
+                  xi_crit=mat.get("xi_crit"), tvis=mat.get("tvis", 0.0), radius=meta["radius"])
+    return {name: values[name] for name in PARAMETER_FIELDS}
 
 
 def read_outcome(directory) -> dict | None:
@@ -379,7 +401,14 @@ def failed(directory) -> bool:
 
 
 def write_outcome(directory, outcome: dict) -> Path:
-    return write_json(Path(directory) / OUTCOME, outcome)
+    """``outcome.json``, its fields in the order of ``OUTCOME_FIELDS``; a field not
+    declared there is refused (declare it there and in docs/records.md)."""
+    unknown = sorted(set(outcome) - set(OUTCOME_FIELDS))
+    if unknown:
+        raise ValueError(f"outcome.json has no field {unknown}: declare it in "
+                         "jkrdt.rundir.OUTCOME_FIELDS and docs/records.md")
+    return write_json(Path(directory) / OUTCOME,
+                      {name: outcome[name] for name in OUTCOME_FIELDS if name in outcome})
 
 
 def record_failure(directory, error: str) -> Path:
