@@ -1,0 +1,87 @@
+"""Could a paper-size collision stop earlier than the settle rule ends it? (issue 46)
+
+    python validation/end_rule.py [--records validation/paper_protocol/records] [RUN_DIR ...]
+
+A candidate end rule stops a run at the first settle check where the largest fragment
+N_lar and the number of fragments have each varied by at most ``c`` N_tot over the last
+``W`` checks: the settle rule's counts without its bonded contacts and dissipation (W = 5,
+c = 1e-4 is that part of the rule every run here used). For each committed
+2 x 50000 record (its checks.csv) and each (W, c), it gives the time the rule would have
+stopped and f_gro there against f_gro at the run's real end. The issue allows such a rule
+for its campaigns only if it moves no committed paper-size f_gro by more than 0.02.
+Reads the records only; writes validation/paper_protocol/end_rule.json.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import sys
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+#: the rules tried: (W checks, c of N_tot); (5, 1e-4) is the settle rule's own counts
+RULES = [(5, 1e-4), (5, 2e-4), (10, 1e-3), (20, 1e-3)]
+ALLOWED = 0.02
+
+
+def series(run: Path) -> tuple[list[float], list[int], list[int], dict]:
+    """Time (s), N_lar and the number of fragments at every settle check (a step written
+    twice counts once, as written last), and the run's collision.json."""
+    latest = {int(r["step"]): r for r in csv.DictReader(open(run / "checks.csv"))}
+    rows = [latest[s] for s in sorted(latest)]
+    return ([float(r["time"]) for r in rows], [int(r["n_largest"]) for r in rows],
+            [int(r["n_fragments"]) for r in rows],
+            json.loads((run / "collision.json").read_text()))
+
+
+def first_stop(counts: list[list[int]], window: int, fraction: float, n_total: int):
+    """The first check at which every one of ``counts`` has varied by at most
+    ``fraction`` n_total over the last ``window`` checks, or None."""
+    for k in range(window, len(counts[0])):
+        if all(max(c[k - window:k + 1]) - min(c[k - window:k + 1]) <= fraction * n_total
+               for c in counts):
+            return k
+    return None
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("runs", nargs="*", type=Path, help="more run directories (running ones too)")
+    p.add_argument("--records", type=Path, default=HERE / "paper_protocol" / "records")
+    args = p.parse_args(argv)
+    runs = sorted(r.parent for r in args.records.glob("n50000_*/v*/*/seed*/checks.csv"))
+    runs += args.runs
+    out = dict(allowed=ALLOWED, rules=[])
+    for window, fraction in RULES:
+        rule = dict(window=window, fraction=fraction, runs=[])
+        for run in runs:
+            t, n_lar, n_frag, meta = series(run)
+            n_tar, n_pro = meta["N_tar"], meta["N_pro"]
+            final = (n_lar[-1] - n_tar) / n_pro
+            k = first_stop([n_lar, n_frag], window, fraction, n_tar + n_pro)
+            rule["runs"].append(dict(
+                run=str(run.relative_to(HERE.parent) if run.is_relative_to(HERE.parent)
+                        else run), B_off=meta["B_off"], end_ns=t[-1] * 1e9, f_gro_end=final,
+                stop_ns=None if k is None else t[k] * 1e9,
+                f_gro_stop=None if k is None else (n_lar[k] - n_tar) / n_pro))
+        moved = [abs(r["f_gro_stop"] - r["f_gro_end"]) for r in rule["runs"]
+                 if r["f_gro_stop"] is not None]
+        rule["largest_move"] = max(moved) if moved else None
+        rule["allowed"] = bool(moved) and max(moved) <= ALLOWED
+        out["rules"].append(rule)
+        print(f"W = {window}, c = {fraction:g}: largest move of f_gro "
+              f"{rule['largest_move']:.3f} ({'allowed' if rule['allowed'] else 'refused'})")
+        for r in rule["runs"]:
+            stop = "never" if r["stop_ns"] is None else \
+                f"{r['stop_ns']:.0f} ns, f_gro {r['f_gro_stop']:+.3f}"
+            print(f"  B_off^2 {r['B_off'] ** 2:.4f}: stops {stop}; the run ended at "
+                  f"{r['end_ns']:.0f} ns with {r['f_gro_end']:+.3f}")
+    (HERE / "paper_protocol" / "end_rule.json").write_text(json.dumps(out, indent=1) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
