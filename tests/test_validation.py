@@ -343,6 +343,17 @@ def test_the_paper_protocol_study_averages_twelve_offsets_and_keeps_every_record
     assert sorted(p.name for p in record.iterdir()) == sorted(
         ["collision.json", "checks.csv", "frames.csv", "outcome.json", "outcome.png",
          "timeline.png"])
+    assert json.loads(before)["left_out"] == []
+    # a run that hit the cap is left out of the averages, and listed with its f_gro
+    outcome = json.loads((record / "outcome.json").read_text())
+    (record / "outcome.json").write_text(json.dumps(dict(outcome, stop_reason="cap")))
+    run_quick("paper_protocol", tmp_path, "--summary-only")
+    done = json.loads((results / "summary.json").read_text())
+    assert len(read_csv(results / "runs.csv")) == len(runs) - 1
+    [out] = done["left_out"]
+    assert out["stop_reason"] == "cap" and out["seed"] == outcome["seed"]
+    assert out["growth_efficiency"] == outcome["growth_efficiency"]
+    assert out["B_off2"] == pytest.approx(outcome["B_off"] ** 2, abs=1e-4)
 
 
 def test_the_size_trend_study_compares_each_candidate_with_base_on_the_same_seeds(tmp_path):

@@ -271,8 +271,21 @@ def figure(summary: dict, results: Path) -> list[Path]:
     return save(fig, results, "fig_protocol")
 
 
+def left_out(outcomes: list[dict]) -> list[dict]:
+    """The records not averaged (a run that hit the cap, failed or is cut off), each with
+    what it holds, so that leaving it out is seen: its question, size, B_off^2, seed, how
+    it ended, when, and f_gro there and at the paper's snapshots."""
+    return [dict(question=o["question"], N_tar=o["N_tar"], B_off2=round(o["B_off"] ** 2, 4),
+                 seed=o.get("seed"), stop_reason=o.get("stop_reason"),
+                 time_end_over_tc=o.get("time_end_over_tc"),
+                 growth_efficiency=o.get("growth_efficiency"),
+                 f_gro_at_us=o["f_gro_at_us"], problem=o.get("problem"))
+            for o in outcomes if o.get("stop_reason") not in COMPLETE]
+
+
 def summarise(records: Path, results: Path, plot: bool = True) -> dict:
-    outcomes = [o for o in load(records) if o.get("stop_reason") in COMPLETE]
+    loaded = load(records)
+    outcomes = [o for o in loaded if o.get("stop_reason") in COMPLETE]
     rows = []
     for o in outcomes:
         r = scalars(o)
@@ -295,7 +308,8 @@ def summarise(records: Path, results: Path, plot: bool = True) -> dict:
                                       for k in QUESTIONS},
                 records=str(records.relative_to(results)) if records.is_relative_to(results)
                 else str(records),
-                results=dict(by_question=summary, statements=statements(rows)))
+                results=dict(by_question=summary, statements=statements(rows)),
+                left_out=left_out(loaded))
     if plot and summary:
         done["figures"] = [p.name for p in figure(summary, results)]
     return done
@@ -314,7 +328,12 @@ def main(argv=None) -> int:
     if not args.summary_only:
         for k in args.questions or list(QUESTIONS):
             run_question(k, stage, runs, args.np)
-    return write_summary(results, summarise(records, results))
+    done = summarise(records, results)
+    for o in done["left_out"]:
+        print(f"left out of the averages: {o['question']} 2 x {o['N_tar']} B_off^2 "
+              f"{o['B_off2']} seed {o['seed']}, {o['stop_reason']}, f_gro "
+              f"{o['growth_efficiency']} (at 1.6 us {o['f_gro_at_us'].get('1.6')})")
+    return write_summary(results, done)
 
 
 if __name__ == "__main__":
