@@ -25,13 +25,12 @@ import dataclasses
 import filecmp
 import gzip
 import json
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-from bench_pair import PROLOGUE, copy_builds, lammps_command, scene, two_builds
+from bench_pair import PROLOGUE, copy_builds, scene, timed_run, two_builds
 from jkrdt import plugin as installed
 from jkrdt.materials import ICE, scales
 from jkrdt.scene import pair_coeff
@@ -105,13 +104,9 @@ def differences(a: Path, b: Path) -> list[str]:
 
 
 def run(text: str, work: Path, setup: tuple, plugin: Path) -> float:
+    """One set-up's run with one build in ``work``: its wall time (s)."""
     work.mkdir(parents=True)
-    (work / "in.bench").write_text(text)
-    cmd, env = lammps_command(setup[2], setup[3], plugin)
-    start = time.perf_counter()
-    subprocess.run(cmd + ["-in", "in.bench", "-log", "log.bench", "-screen", "none"],
-                   cwd=work, env=env, check=True)
-    return time.perf_counter() - start
+    return timed_run(text, work, setup[2], setup[3], plugin)["process_seconds"]
 
 
 def main(argv=None) -> int:

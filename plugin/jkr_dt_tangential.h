@@ -227,7 +227,7 @@ inline DisplacementsT<T> displacements(const ContactStateT<T> &c, const V3T<T> &
 // the tangential channels of section 2.2, declared once: X(enum, name, potential). Every
 // list of channels is made from this one and JKRDT_NORMAL_CHANNELS (jkr_dt_contact.h): the
 // ledger's columns, compute pair jkr/dt's values and their names, which Python's
-// jkrdt.ledger gives too (tests/test_structure.py compares them)
+// jkrdt.ledger gives too (tests/test_kernel.py compares them)
 #define JKRDT_TANGENTIAL_CHANNELS(X) X(SLIDE, "sliding", "U_s") X(ROLL, "rolling", "U_r") \
   X(TWIST, "twisting", "U_t")
 #define JKRDT_CHANNEL_ENUM(e, name, potential) e,

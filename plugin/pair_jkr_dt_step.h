@@ -72,6 +72,11 @@ struct PairJKRDT::View {
   const JKRDT::ContactConstants *scene_K;    // one set for the scene (BY_SCENE), else null
   bool lanes;    // the tangential step of a block's contacts four at a time: one set of
                  // constants, contacts that store their pointers
+
+  // a grain of the pair is in a fragment that has departed for good
+  bool departed_pair(int p, int q) const { return departed && ((mask[p] | mask[q]) & departed); }
+  // atom a is this thread's, to write to directly
+  bool mine(int a) const { return !thread_of || thread_of[a] == me; }
 };
 
 // where a pair evaluated with other constants than the scene's finds them
@@ -173,10 +178,9 @@ template <bool TANGENTIAL> struct PairJKRDT::Block {
   {
     const int p = i[k], q = j[k];
     if (!w.bonded[slot[k]] || q >= w.nlocal || (TANGENTIAL && p >= w.nlocal) ||
-        (w.departed && ((w.mask[p] | w.mask[q]) & w.departed)))
+        w.departed_pair(p, q))
       return false;
-    return !w.thread_of ||
-        (w.thread_of[q] == w.me && (!TANGENTIAL || w.thread_of[p] == w.me));
+    return w.mine(q) && (!TANGENTIAL || w.mine(p));
   }
 };
 
@@ -234,7 +238,7 @@ template <bool TANGENTIAL, bool LEAN> struct PairJKRDT::PairStep {
     // a grain of a fragment that has left for good meets nothing, and its own contacts
     // stand still: they are only evaluated, as a set-up does, for their potential energy
     const int owned = LEAN ? 2 : (p < w.nlocal) + (q < w.nlocal);    // half per owned atom
-    const bool parked = !LEAN && w.departed && ((w.mask[p] | w.mask[q]) & w.departed);
+    const bool parked = !LEAN && w.departed_pair(p, q);
     if (parked && !(bonded && w.eflag)) {
       if (bonded) contact_ends += owned;
       return Eval::SKIP;
@@ -360,7 +364,7 @@ template <bool TANGENTIAL, bool LEAN> struct PairJKRDT::PairStep {
     constexpr int nloss = TANGENTIAL ? JKRDT::NLOSS : JKRDT::LOSS_DAMPING + 1;
     if (!LEAN && a >= w.nlocal) return;
     double *fa, *ta, *far_loss = nullptr;
-    if (LEAN || !w.thread_of || w.thread_of[a] == w.me) {
+    if (LEAN || w.mine(a)) {
       fa = w.f + 3 * a;
       ta = w.torque + 3 * a;
     } else {    // an owned atom of another thread gets its share through acc.far

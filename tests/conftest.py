@@ -34,7 +34,8 @@ def jkr_potential(delta, s):
     return 4.0 * 6 ** (1 / 3) * s.F_c * s.delta_c * (0.8 * x ** 5 - 4 / 3 * x ** 3.5 + x ** 2 / 3)
 
 
-ENERGY_THERMO = f"step ke c_erot pe c_p[1] {' '.join(jkrdt_ledger.LEDGER)} {jkrdt_ledger.CONTACTS}"
+#: the thermo line of the small scenes: the energies and all of compute pair jkr/dt's values
+ENERGY_THERMO = "step ke c_erot pe c_p[*]"
 
 
 def two_grain_scene(lmp, separation, v_rel=0.0, material=ICE, coeff_extra="frictionless",

@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 #: the dissipation channels: the kernel's ledger columns (plugin/jkr_dt_contact.h: its
-#: JKRDT_NORMAL_CHANNELS, then its JKRDT_TANGENTIAL_CHANNELS), which tests/test_structure.py
+#: JKRDT_NORMAL_CHANNELS, then its JKRDT_TANGENTIAL_CHANNELS), which tests/test_kernel.py
 #: compares with these
 CHANNELS = ["events", "damping", "sliding", "rolling", "twisting"]
 #: the contact potentials: U_n, then one per tangential channel
