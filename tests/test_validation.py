@@ -343,17 +343,31 @@ def test_the_paper_protocol_study_averages_twelve_offsets_and_keeps_every_record
     assert sorted(p.name for p in record.iterdir()) == sorted(
         ["collision.json", "checks.csv", "frames.csv", "outcome.json", "outcome.png",
          "timeline.png"])
-    assert json.loads(before)["left_out"] == []
-    # a run that hit the cap is left out of the averages, and listed with its f_gro
+    assert json.loads(before)["left_out"] == json.loads(before)["ended_at_cap"] == []
+    # a run that ended at its cap is averaged at its end and listed with the range of its
+    # f_gro over the last 1.6 us of its checks (here its whole run, far shorter)
     outcome = json.loads((record / "outcome.json").read_text())
     (record / "outcome.json").write_text(json.dumps(dict(outcome, stop_reason="cap")))
     run_quick("paper_protocol", tmp_path, "--summary-only")
     done = json.loads((results / "summary.json").read_text())
+    assert len(read_csv(results / "runs.csv")) == len(runs)
+    assert done["results"] == json.loads(before)["results"]
+    [cap] = done["ended_at_cap"]
+    assert cap["seed"] == outcome["seed"] and done["left_out"] == []
+    assert cap["B_off2"] == pytest.approx(outcome["B_off"] ** 2, abs=1e-4)
+    checks = read_csv(record / "checks.csv")
+    assert checks[-1]["time"] < 1.6e-6
+    f = [(c["n_largest"] - outcome["N_tar"]) / outcome["N_pro"] for c in checks]
+    assert cap["f_gro_last_span"] == [min(f), max(f)]
+    assert f[-1] == outcome["growth_efficiency"]
+    # a run that failed or was cut off is left out of the averages, and listed
+    (record / "outcome.json").write_text(json.dumps(dict(outcome, stop_reason="cut off")))
+    run_quick("paper_protocol", tmp_path, "--summary-only")
+    done = json.loads((results / "summary.json").read_text())
     assert len(read_csv(results / "runs.csv")) == len(runs) - 1
     [out] = done["left_out"]
-    assert out["stop_reason"] == "cap" and out["seed"] == outcome["seed"]
+    assert out["stop_reason"] == "cut off" and out["seed"] == outcome["seed"]
     assert out["growth_efficiency"] == outcome["growth_efficiency"]
-    assert out["B_off2"] == pytest.approx(outcome["B_off"] ** 2, abs=1e-4)
 
 
 def test_the_size_trend_study_compares_each_candidate_with_base_on_the_same_seeds(tmp_path):

@@ -7,9 +7,11 @@ N_lar and the number of fragments have each varied by at most ``c`` N_tot over t
 ``W`` checks: the settle rule's counts without its bonded contacts and dissipation (W = 5,
 c = 1e-4 is that part of the rule every run here used). For each committed
 2 x 50000 record (its checks.csv) and each (W, c), it gives the time the rule would have
-stopped and f_gro there against f_gro at the run's real end. The issue allows such a rule
-for its campaigns only if it moves no committed paper-size f_gro by more than 0.02.
-Reads the records only; writes validation/paper_protocol/end_rule.json.
+stopped and f_gro there against f_gro at the run's real end. It does the same for a lower
+cap (the paper stage's, ``paper_protocol.PAPER_CAP_TC``): a run stops at the first check
+at or after it. The issue allows such a rule for its campaigns only if it moves no
+committed paper-size f_gro by more than 0.02. Reads the records only; writes
+validation/paper_protocol/end_rule.json.
 """
 
 from __future__ import annotations
@@ -20,6 +22,8 @@ import json
 import sys
 from pathlib import Path
 
+from paper_protocol import PAPER_CAP_TC
+
 HERE = Path(__file__).resolve().parent
 #: the rules tried: (W checks, c of N_tot); (5, 1e-4) is the settle rule's own counts
 RULES = [(5, 1e-4), (5, 2e-4), (10, 1e-3), (20, 1e-3)]
@@ -28,12 +32,40 @@ ALLOWED = 0.02
 
 def series(run: Path) -> tuple[list[float], list[int], list[int], dict]:
     """Time (s), N_lar and the number of fragments at every settle check (a step written
-    twice counts once, as written last), and the run's collision.json."""
+    twice counts once, as written last), and the run's collision.json with its t_c (s)."""
     latest = {int(r["step"]): r for r in csv.DictReader(open(run / "checks.csv"))}
     rows = [latest[s] for s in sorted(latest)]
+    meta = json.loads((run / "collision.json").read_text())
+    last = max(latest)
+    meta["t_c"] = float(latest[last]["time"]) / last / meta["dt_over_tc"]
     return ([float(r["time"]) for r in rows], [int(r["n_largest"]) for r in rows],
-            [int(r["n_fragments"]) for r in rows],
-            json.loads((run / "collision.json").read_text()))
+            [int(r["n_fragments"]) for r in rows], meta)
+
+
+def capped(runs: list[Path], cap_tc: float) -> dict:
+    """Each run stopped at the first check at or after ``cap_tc`` (its end if sooner)."""
+    rule = dict(cap_tc=cap_tc, runs=[])
+    for run in runs:
+        t, n_lar, _, meta = series(run)
+        k = next((i for i, x in enumerate(t) if x >= cap_tc * meta["t_c"] * (1 - 1e-9)),
+                 len(t) - 1)
+        f = [(n - meta["N_tar"]) / meta["N_pro"] for n in n_lar]
+        rule["runs"].append(dict(run=named(run), B_off=meta["B_off"], end_ns=t[-1] * 1e9,
+                                 end_tc=t[-1] / meta["t_c"], f_gro_end=f[-1],
+                                 stop_ns=t[k] * 1e9, f_gro_stop=f[k]))
+    rule["largest_move"] = max(abs(r["f_gro_stop"] - r["f_gro_end"]) for r in rule["runs"])
+    rule["allowed"] = rule["largest_move"] <= ALLOWED
+    print(f"a cap at {cap_tc:g} t_c: largest move of f_gro {rule['largest_move']:.3f} "
+          f"({'allowed' if rule['allowed'] else 'refused'})")
+    for r in rule["runs"]:
+        print(f"  B_off^2 {r['B_off'] ** 2:.4f}: stops at {r['stop_ns']:.0f} ns with "
+              f"{r['f_gro_stop']:+.3f}; the run ended at {r['end_ns']:.0f} ns "
+              f"({r['end_tc']:.0f} t_c) with {r['f_gro_end']:+.3f}")
+    return rule
+
+
+def named(run: Path) -> str:
+    return str(run.relative_to(HERE.parent) if run.is_relative_to(HERE.parent) else run)
 
 
 def first_stop(counts: list[list[int]], window: int, fraction: float, n_total: int):
@@ -63,8 +95,7 @@ def main(argv=None) -> int:
             final = (n_lar[-1] - n_tar) / n_pro
             k = first_stop([n_lar, n_frag], window, fraction, n_tar + n_pro)
             rule["runs"].append(dict(
-                run=str(run.relative_to(HERE.parent) if run.is_relative_to(HERE.parent)
-                        else run), B_off=meta["B_off"], end_ns=t[-1] * 1e9, f_gro_end=final,
+                run=named(run), B_off=meta["B_off"], end_ns=t[-1] * 1e9, f_gro_end=final,
                 stop_ns=None if k is None else t[k] * 1e9,
                 f_gro_stop=None if k is None else (n_lar[k] - n_tar) / n_pro))
         moved = [abs(r["f_gro_stop"] - r["f_gro_end"]) for r in rule["runs"]
@@ -79,6 +110,7 @@ def main(argv=None) -> int:
                 f"{r['stop_ns']:.0f} ns, f_gro {r['f_gro_stop']:+.3f}"
             print(f"  B_off^2 {r['B_off'] ** 2:.4f}: stops {stop}; the run ended at "
                   f"{r['end_ns']:.0f} ns with {r['f_gro_end']:+.3f}")
+    out["caps"] = [capped(runs, PAPER_CAP_TC)]
     (HERE / "paper_protocol" / "end_rule.json").write_text(json.dumps(out, indent=1) + "\n")
     return 0
 

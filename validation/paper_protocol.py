@@ -20,7 +20,11 @@ paper's 2 x 50000 where the placement says it decides something (``--stage paper
 1, each collision on all ranks; seed 2 for c). One campaign per question, size and offset
 (``RUNS/n<N>_<question>_b2_<B_off^2>``), in the order of QUESTIONS; a second call resumes
 them. Every run ends by the settle rule, its dt chosen by ``--dt auto`` for max |dE| /
-E_imp <= 1e-3 (vfra_size.TOLERANCE).
+E_imp <= 1e-3 (vfra_size.TOLERANCE); at the paper's size a run that has not settled by
+PAPER_CAP_TC ends there and is averaged at its end (``summary.json``'s ``ended_at_cap``
+lists each with how far its f_gro moved over its last 1.6 us; ``end_rule.py`` measures
+the cap against the runs' real ends), and a run that failed or was cut off is left out
+(``left_out``).
 
 The small record of every finished run (``jkrdt.rundir.RECORD``: outcome.json,
 checks.csv, collision.json, frames.csv, the outcome and timeline pictures) is copied to
@@ -71,9 +75,24 @@ QUESTIONS = {
     "d": dict(model="frictionless", v_col=31.6, b_off2=TWELFTHS_FIRST,
               paper="<f_gro> about 0 at v_fra = 30 m/s (Fig. 2)"),
 }
+#: the paper stage's cap, t_c (4.4 us for 0.1 um ice): a run that has not settled by then
+#: ends there and is counted at its end, as the paper's runs end at a time it does not
+#: state. Twice the latest any paper-size run settled (8302 t_c, b at 6/12) and 2.7 times
+#: the paper's last snapshot (1.6 us); at 10^5 grains N_lar can drift by tens of grains a
+#: check for microseconds after the outcome is fixed (b at 9/12), which the settle rule's
+#: counts (10 grains) never let settle. Measured against the runs' real ends: end_rule.py
+PAPER_CAP_TC = 16000.0
+#: the paper-size campaigns started with the default cap (SettleRule.cap_tc) before the
+#: paper stage's was lowered: they keep it, so that they resume under the spec they began
+STARTED_WITH_DEFAULT_CAP = {"b": (0.0, 1 / 12, 2 / 12, 3 / 12, 6 / 12, 9 / 12)}
 #: the sizes a question is asked at: its seeds, and the ranks one collision shares
 STAGES = {"place": dict(n=5000, seeds=[1, 2], ranks_per_run=1),
-          "paper": dict(n=50000, seeds=[1], ranks_per_run=2, more_seeds={"c": [1, 2]})}
+          "paper": dict(n=50000, seeds=[1], ranks_per_run=2, more_seeds={"c": [1, 2]},
+                        cap_tc=PAPER_CAP_TC, default_cap=STARTED_WITH_DEFAULT_CAP)}
+#: how a run may end and be averaged here: settled, or at the cap of its stage
+COUNTED = COMPLETE + ("cap",)
+#: the span (us) before a capped run's end over which its f_gro range is reported
+CAP_SPAN_US = 1.6
 #: the tests' variant: every offset of a question in one campaign
 QUICK = dict(n=24, seeds=[1, 2], ranks_per_run=1, one_campaign=True)
 
@@ -84,9 +103,16 @@ def campaign_specs(question: str, stage: dict) -> dict[str, dict]:
     q = QUESTIONS[question]
     seeds = stage.get("more_seeds", {}).get(question, stage["seeds"])
     groups = [q["b_off2"]] if stage.get("one_campaign") else [[b2] for b2 in q["b_off2"]]
+    kept = stage.get("default_cap", {}).get(question, ())
+
+    def settle(b2):    # the stage's cap, unless the campaign began with the default one
+        if "cap_tc" not in stage or any(abs(b2[0] - k) < 1e-9 for k in kept):
+            return {}
+        return dict(settle=dict(cap_tc=stage["cap_tc"]))
+
     return {f"n{stage['n']}/{question}/b2_{b2[0]:.4f}" + ("_all" if len(b2) > 1 else ""):
             model_spec(q["model"], stage["n"], v_col=[q["v_col"]], b_off2=b2, seeds=seeds,
-                       dt="auto", tolerance=TOLERANCE)
+                       dt="auto", tolerance=TOLERANCE, **settle(b2))
             for b2 in groups}
 
 
@@ -120,6 +146,15 @@ def f_gro_at(record: Path, n_tar: int, n_pro: int) -> dict[str, float | None]:
     return out
 
 
+def f_gro_range_before_end(record: Path, n_tar: int, n_pro: int) -> list[float]:
+    """[min, max] of f_gro over the run's settle checks in its last CAP_SPAN_US: for a run
+    counted at its cap, how far its outcome still moved."""
+    rows = read_csv(record / rundir.CHECKS)
+    since = rows[-1]["time"] - CAP_SPAN_US * 1e-6
+    f = [(r["n_largest"] - n_tar) / n_pro for r in rows if r["time"] >= since]
+    return [min(f), max(f)]
+
+
 def load(records: Path) -> list[dict]:
     """Every kept record's outcome, with its size, question and f_gro at SNAPSHOTS_US."""
     out = []
@@ -127,6 +162,7 @@ def load(records: Path) -> list[dict]:
         o = json.loads(path.read_text())
         o["n"], o["question"] = question_of(path.parent, records)
         o["f_gro_at_us"] = f_gro_at(path.parent, o["N_tar"], o["N_pro"])
+        o["record"] = path.parent
         out.append(o)
     return out
 
@@ -271,21 +307,33 @@ def figure(summary: dict, results: Path) -> list[Path]:
     return save(fig, results, "fig_protocol")
 
 
+def listed(o: dict) -> dict:
+    """What a record holds, for the lists of records not settled: its question, size,
+    B_off^2, seed, how it ended, when, and f_gro there and at the paper's snapshots."""
+    return dict(question=o["question"], N_tar=o["N_tar"], B_off2=round(o["B_off"] ** 2, 4),
+                seed=o.get("seed"), stop_reason=o.get("stop_reason"),
+                time_end_over_tc=o.get("time_end_over_tc"),
+                growth_efficiency=o.get("growth_efficiency"),
+                f_gro_at_us=o["f_gro_at_us"], problem=o.get("problem"))
+
+
+def ended_at_cap(outcomes: list[dict]) -> list[dict]:
+    """The records averaged at their cap, each with the range of its f_gro over its last
+    CAP_SPAN_US, so that how far a capped outcome still moved is seen."""
+    return [dict(listed(o), f_gro_last_span=f_gro_range_before_end(
+                 o["record"], o["N_tar"], o["N_pro"]), span_us=CAP_SPAN_US)
+            for o in outcomes if o.get("stop_reason") == "cap"]
+
+
 def left_out(outcomes: list[dict]) -> list[dict]:
-    """The records not averaged (a run that hit the cap, failed or is cut off), each with
-    what it holds, so that leaving it out is seen: its question, size, B_off^2, seed, how
-    it ended, when, and f_gro there and at the paper's snapshots."""
-    return [dict(question=o["question"], N_tar=o["N_tar"], B_off2=round(o["B_off"] ** 2, 4),
-                 seed=o.get("seed"), stop_reason=o.get("stop_reason"),
-                 time_end_over_tc=o.get("time_end_over_tc"),
-                 growth_efficiency=o.get("growth_efficiency"),
-                 f_gro_at_us=o["f_gro_at_us"], problem=o.get("problem"))
-            for o in outcomes if o.get("stop_reason") not in COMPLETE]
+    """The records not averaged (a run that failed or is cut off), so that leaving each
+    out is seen."""
+    return [listed(o) for o in outcomes if o.get("stop_reason") not in COUNTED]
 
 
 def summarise(records: Path, results: Path, plot: bool = True) -> dict:
     loaded = load(records)
-    outcomes = [o for o in loaded if o.get("stop_reason") in COMPLETE]
+    outcomes = [o for o in loaded if o.get("stop_reason") in COUNTED]
     rows = []
     for o in outcomes:
         r = scalars(o)
@@ -309,7 +357,7 @@ def summarise(records: Path, results: Path, plot: bool = True) -> dict:
                 records=str(records.relative_to(results)) if records.is_relative_to(results)
                 else str(records),
                 results=dict(by_question=summary, statements=statements(rows)),
-                left_out=left_out(loaded))
+                ended_at_cap=ended_at_cap(outcomes), left_out=left_out(loaded))
     if plot and summary:
         done["figures"] = [p.name for p in figure(summary, results)]
     return done
@@ -329,6 +377,12 @@ def main(argv=None) -> int:
         for k in args.questions or list(QUESTIONS):
             run_question(k, stage, runs, args.np)
     done = summarise(records, results)
+    for o in done["ended_at_cap"]:
+        low, high = o["f_gro_last_span"]
+        print(f"averaged at its cap: {o['question']} 2 x {o['N_tar']} B_off^2 {o['B_off2']} "
+              f"seed {o['seed']}, f_gro {o['growth_efficiency']:+.3f} at "
+              f"{o['time_end_over_tc']:.0f} t_c ({low:+.3f} to {high:+.3f} over the last "
+              f"{o['span_us']:g} us)")
     for o in done["left_out"]:
         print(f"left out of the averages: {o['question']} 2 x {o['N_tar']} B_off^2 "
               f"{o['B_off2']} seed {o['seed']}, {o['stop_reason']}, f_gro "
