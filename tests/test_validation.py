@@ -323,6 +323,23 @@ def test_the_paper_protocol_study_averages_twelve_offsets_and_keeps_every_record
     assert m["per_seed"]["2"] == pytest.approx(per_seed[2], abs=1e-12)
     assert m["mean"] == pytest.approx(np.mean(list(per_seed.values())), abs=1e-12)
     assert m["se"] == pytest.approx(abs(per_seed[1] - per_seed[2]) / 2, abs=1e-12)
+    assert b["sign_open"] is None
+    # with offsets still to run, what they must average for <f_gro> < 0: eq. (1) weighs
+    # each inner twelfth 1/12, so with 4/12, 5/12 and 7/12 open they weigh 3/12, and the
+    # run offsets with the open ones at that average give <f_gro> = 0
+    sys.path.insert(0, str(ROOT / "validation"))
+    try:
+        from paper_protocol import what_the_rest_needs
+    finally:
+        sys.path.pop(0)
+    open_k = (4, 5, 7)
+    ran = [j for j in range(12) if j not in open_k]
+    need = what_the_rest_needs([j / 12 for j in ran], [b["f_gro"][j] for j in ran])
+    assert need["to_run"] == ["4/12", "5/12", "7/12"]
+    assert need["weight_to_run"] == pytest.approx(3 / 12, abs=1e-12)
+    filled = [need["rest_must_average_below"] if j in open_k else b["f_gro"][j]
+              for j in range(12)]
+    assert np.trapezoid(filled + [0.0], k) == pytest.approx(0.0, abs=1e-12)
     # N_con - N_cut is the change in bonded contacts, exactly, in every run
     for o in map(json.loads, (p.read_text() for p in (results / "records").rglob(
             "outcome.json"))):

@@ -55,7 +55,8 @@ import numpy as np
 from bpca3d_models import MODELS, model_spec
 from common import campaign_study_parser, run_campaigns, save, study_paths, write_summary
 from jkrdt import protocol, rundir
-from jkrdt.analysis.summary import b_off_groups, mean_diagnostics, scalars, seed_scatter
+from jkrdt.analysis.summary import (b_off_average, b_off_groups, mean_diagnostics, scalars,
+                                   seed_scatter)
 from jkrdt.analysis.tables import read_csv, write_csv
 from jkrdt.stopping import COMPLETE
 from vfra_size import TOLERANCE
@@ -168,10 +169,27 @@ def load(records: Path) -> list[dict]:
     return out
 
 
-def question_summary(runs: list[dict]) -> dict:
+def what_the_rest_needs(b2, f) -> dict | None:
+    """Where only some of the paper's twelve offsets have run: those still to run, the part
+    of eq. (1)'s <f_gro> the others make, and the average f_gro of the rest below which
+    <f_gro> is negative (the grazing 12/12 at 0). None off the paper's grid or on all of it."""
+    k = [round(12 * b) for b in b2]
+    if len(k) == 12 or any(abs(12 * b - j) > 1e-6 for b, j in zip(b2, k)):
+        return None
+    f_of = dict(zip(k, f))
+    grid = protocol.B_OFF2
+    part = float(b_off_average(grid, [f_of.get(j, 0.0) for j in range(12)], grazing=0.0))
+    weight = float(b_off_average(grid, [float(j not in f_of) for j in range(12)],
+                                 grazing=0.0))
+    return dict(to_run=[f"{j}/12" for j in range(12) if j not in f_of], part_run=part,
+                weight_to_run=weight, rest_must_average_below=-part / weight)
+
+
+def question_summary(runs: list[dict], twelve: bool) -> dict:
     """One question at one size: f_gro per offset (by seed and seeds averaged), N_con and
     N_cut per offset over N_tot, and where the twelve offsets ran, eq. (1)'s <f_gro> with
-    its seed scatter and the diagnostics' eq. (1) means."""
+    its seed scatter and the diagnostics' eq. (1) means; for a question asked on the
+    ``twelve`` offsets while some are still to run, what they must average for <f_gro> < 0."""
     f_gro = lambda o: o["growth_efficiency"]    # noqa: E731
     b2, f = b_off_groups(runs, f_gro)
     n_tot = runs[0]["n_total"]
@@ -191,6 +209,8 @@ def question_summary(runs: list[dict]) -> dict:
           for t in runs[0]["f_gro_at_us"]
           if all(o["f_gro_at_us"][t] is not None for o in runs)}
     out["f_gro_at_us"] = {t: [float(x) for x in f] for t, f in at.items()}
+    if twelve:
+        out["sign_open"] = what_the_rest_needs(b2, f)
     if out["paper_grid"]:
         out["mean_f_gro"] = seed_scatter(runs, f_gro, protocol.GRAZING["growth_efficiency"])
         out["means"] = mean_diagnostics(runs)
@@ -348,7 +368,8 @@ def summarise(records: Path, results: Path, plot: bool = True) -> dict:
     by = defaultdict(lambda: defaultdict(list))
     for o in outcomes:
         by[o["question"]][o["N_tar"]].append(o)
-    summary = {k: {n: question_summary(runs) for n, runs in sorted(by[k].items())}
+    summary = {k: {n: question_summary(runs, len(QUESTIONS[k]["b_off2"]) == 12)
+                   for n, runs in sorted(by[k].items())}
                for k in QUESTIONS if k in by}
     done = dict(study="paper_protocol", protocol="the paper's offsets B_off^2 = k/12 "
                 "(k = 0 ... 11, 12/12 grazing taken as f_gro 0) for b and d; one offset for "
@@ -362,6 +383,32 @@ def summarise(records: Path, results: Path, plot: bool = True) -> dict:
     if plot and summary:
         done["figures"] = [p.name for p in figure(summary, results)]
     return done
+
+
+def table(by_question: dict) -> list[str]:
+    """The paper's Fig. B.1 as lines, per question and size: f_gro of each offset and seed,
+    N_con and N_cut over N_tot; then <f_gro> of eq. (1), or what the offsets still to run
+    must average for it to be negative."""
+    lines = []
+    for k, sizes in by_question.items():
+        q = QUESTIONS[k]
+        for size, s in sizes.items():
+            lines.append(f"{k}: {q['model']}, {q['v_col']:g} m/s, 2 x {size}; paper: "
+                         f"{q['paper']}")
+            lines.append("  B_off^2  f_gro by seed           N_con/N_tot  N_cut/N_tot")
+            for b, con, cut in zip(s["B_off2"], s["N_con_over_N_tot"], s["N_cut_over_N_tot"]):
+                seeds = s["f_gro_per_seed"][f"{b:.4f}"]
+                f = "  ".join(f"{v:+.3f} ({seed})" for seed, v in sorted(seeds.items()))
+                lines.append(f"  {protocol.twelfths(b, 1e-3) or f'{b:.4f}':7s}  {f:22s} "
+                             f"{con:11.2f}  {cut:11.2f}")
+            if s.get("mean_f_gro"):
+                m = s["mean_f_gro"]
+                lines.append(f"  <f_gro> (eq. 1) {m['mean']:+.3f} +- {m['se']:.3f}")
+            elif s.get("sign_open"):
+                o = s["sign_open"]
+                lines.append(f"  to run: {' '.join(o['to_run'])}; <f_gro> < 0 needs them to "
+                             f"average below {o['rest_must_average_below']:+.3f}")
+    return lines
 
 
 def main(argv=None) -> int:
@@ -378,6 +425,7 @@ def main(argv=None) -> int:
         for k in args.questions or list(QUESTIONS):
             run_question(k, stage, runs, args.np)
     done = summarise(records, results)
+    print("\n".join(table(done["results"]["by_question"])))
     for o in done["ended_at_cap"]:
         low, high = o["f_gro_last_span"]
         print(f"averaged at its cap: {o['question']} 2 x {o['N_tar']} B_off^2 {o['B_off2']} "
