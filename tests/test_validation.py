@@ -588,3 +588,40 @@ def test_the_size_trend_places_v_fra_as_the_smaller_study_did():
     # 15 -> 22 m/s), and the fit's slope is positive
     for model in ("frictional", "frictionless"):
         assert trend[model]["fit"]["b"] > 0
+
+
+def test_the_fixed_end_study_continues_settled_runs_as_the_same_collision(tmp_path):
+    # validation/fixed_end.py --quick: the quick protocol's head-on 2 x 24 runs at 100 m/s
+    # (settled by about 400 t_c) continued from their final.restart to 1200 t_c on 2 ranks
+    # (they ran on 1), the settle rule watching only. The continuation is the same
+    # collision: its first sample is the settled run's last in every energy channel (the
+    # contact state and the ledger come back with the restart file), the conserved total
+    # (ke + erot + pe + dissipated) holds to --dt auto's 1e-3 E_imp over it, its checks go
+    # on a whole check interval apart, and it ends at the first check at or after the
+    # fixed end (a cap is a whole number of checks)
+    from jkrdt import ledger, rundir
+
+    protocol_results = run_quick("paper_protocol", tmp_path / "protocol", "--questions", "a")
+    results = run_quick("fixed_end", tmp_path / "fixed", "--np", "2",
+                        "--protocol-runs", str(tmp_path / "protocol" / "runs"),
+                        "--protocol-records", str(protocol_results / "records"))
+    summary = json.loads((results / "summary.json").read_text())
+    rows = summary["results"]["offsets"]
+    assert len(rows) == 2 and all(r["continued"] and r["reaches_fixed_end"] for r in rows)
+    for r in rows:
+        before = tmp_path / "protocol" / "runs" / r["record"]
+        after = tmp_path / "fixed" / "runs" / r["record"]
+        meta = json.loads((before / "collision.json").read_text())
+        a = ledger.energy_budget(rundir.read_thermo(before / "log.lammps"))
+        b = ledger.energy_budget(rundir.read_thermo(after / "log.lammps"))
+        for channel in a:
+            assert b[channel][0] == a[channel][-1], channel
+        assert np.abs(b["total"] - b["total"][0]).max() < 1e-3 * meta["E_imp"]
+        first, more = read_csv(before / "checks.csv"), read_csv(after / "checks.csv")
+        steps = [c["step"] for c in first] + [c["step"] for c in more]
+        assert len(set(np.diff(steps))) == 1
+        t_c = first[-1]["time"] / first[-1]["step"] / meta["dt_over_tc"]
+        every = steps[1] - steps[0]
+        assert 1200 * t_c <= more[-1]["time"] < 1200 * t_c + every * meta["dt_over_tc"] * t_c
+        assert r["fixed_end_us"] == pytest.approx(more[-1]["time"] * 1e6, rel=1e-12)
+        assert r["f_gro_fixed_end"] == (more[-1]["n_largest"] - 24) / 24

@@ -1,0 +1,236 @@
+"""Does f_gro still move after the settle rule ends a paper-size run? (issue 46, item 5)
+
+At 2 x 50000 the frictionless collisions at 39.8 m/s make one body that parts into two
+(2/12 at 1.63 us, 3/12 at 1.37 us, 6/12 at 0.69 us), and 4/12 parted twice (1.25 and
+1.7 us): the outcome moves on microsecond scales, while the settle rule watches 250 t_c
+(68 ns). The paper's runs end at a time it does not state. This study puts every
+paper-size run of a question on one clock: each run the settle rule ended before the
+paper stage's cap (``paper_protocol.PAPER_CAP_TC``, 4.4 us) is continued from its
+final.restart to that time with the settle checks written but the rule off, so that
+f_gro is read at one fixed end for every offset (a run that hit the cap is there already).
+
+    ./run validate fixed_end                 # continue each settled run (hours; resumable)
+    ./run validate fixed_end --summary-only  # the results from the records kept so far
+
+Continuations run one at a time over --np ranks, in the protocol's order of offsets
+(``paper_protocol.TWELFTHS_FIRST``), each in RUNS/<campaign>/ (a second call resumes a cut-off one from its newer
+restart file). As each ends, its checks.csv is kept below RESULTS/records/<campaign>/, and
+the results come from the records alone: each offset's f_gro(t) from the original run's
+checks and its continuation's, f_gro at the settle end and at the fixed end, <f_gro> of
+eq. (1) at both ends where the twelve offsets are in (else what the open offsets must
+average for <f_gro> < 0), and fig_fixed_end (f_gro against time, one line per offset).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+from common import BIN, campaign_study_parser, save, study_paths, write_summary
+from jkrdt import protocol, rundir
+from jkrdt.analysis.summary import b_off_average
+from jkrdt.analysis.tables import read_csv
+from paper_protocol import PAPER_CAP_TC, QUESTIONS, TWELFTHS_FIRST, what_the_rest_needs
+
+HERE = Path(__file__).resolve().parent
+#: a settle window no run reaches: the checks are written, the rule never ends the run
+WATCH_ONLY = 10 ** 9
+#: the quick variant's fixed end (t_c): its head-on 2 x 24 runs settle by about 400 t_c
+QUICK_CAP_TC = 1200.0
+#: what each continued run's record holds
+KEPT = (rundir.CHECKS, rundir.META)
+
+
+def continue_run(run: Path, out: Path, cap_tc: float) -> None:
+    """Continue ``run`` (ended by the settle rule) in ``out`` to ``cap_tc`` with the settle
+    checks on and the rule off, from its final.restart, or from ``out``'s newer restart
+    file where an earlier call was cut off. Every rank of COMM_WORLD calls this."""
+    from mpi4py import MPI
+
+    from jkrdt.session import Session
+    from jkrdt.stopping import SettleRule
+
+    comm = MPI.COMM_WORLD
+    rule = SettleRule(window=WATCH_ONLY, cap_tc=cap_tc)
+    end = rule.cap_steps(rundir.read(run).time_step()[0])
+    point = None
+    if comm.rank == 0:
+        out.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(run / rundir.META, out / rundir.META)    # resume_point looks for it
+        point = rundir.resume_point(out, end) if (out / rundir.LOG).exists() else None
+        if point is not None:
+            rundir.cut_back(out, point[1])
+    point = comm.bcast(point, root=0)
+    if point is None:
+        start = json.loads((run / rundir.OUTCOME).read_text())["stop_step"]
+        restart, append = run / rundir.FINAL_RESTART, False
+    else:
+        (restart, start), append = point, True
+    with Session(run, out, every=1, settle=rule, restart=restart, append=append,
+                 variables=dict(steps=end - start)) as s:
+        s.run_until_settled(progress=False)
+        s.finish()
+
+
+def to_continue(runs: Path, size: int, question: str, cap_tc: float,
+                twelfths=None) -> list[Path]:
+    """The runs of ``question`` at 2 x ``size`` that the settle rule ended before
+    ``cap_tc``, in TWELFTHS_FIRST's order (their final.restart at hand); ``twelfths``:
+    only the offsets B_off^2 = k/12 of these k."""
+    out = []
+    for b2 in TWELFTHS_FIRST:
+        if twelfths is not None and round(12 * b2) not in twelfths:
+            continue
+        for run in sorted(runs.glob(f"n{size}_{question}_b2_{b2:.4f}/v*/b2_*/seed*")):
+            outcome = run / rundir.OUTCOME
+            if not (outcome.exists() and (run / rundir.FINAL_RESTART).exists()):
+                continue
+            o = json.loads(outcome.read_text())
+            if o.get("stop_reason") == "settled" and o["time_end_over_tc"] < cap_tc:
+                out.append(run)
+    return out
+
+
+def series(checks: list[dict], n_tar: int, n_pro: int) -> tuple[list[float], list[float]]:
+    """Time (us) and f_gro at every settle check, a step written twice counted once."""
+    latest = {int(r["step"]): r for r in checks}
+    rows = [latest[s] for s in sorted(latest)]
+    return ([r["time"] * 1e6 for r in rows], [(r["n_largest"] - n_tar) / n_pro for r in rows])
+
+
+def t_c_us(checks: list[dict], meta: dict) -> float:
+    """t_c (us) of a run: its time step (time over step at its last check) over dt / t_c."""
+    return checks[-1]["time"] / checks[-1]["step"] / meta["dt_over_tc"] * 1e6
+
+
+def offsets(records: Path, kept: Path, size: int, question: str, cap_tc: float) -> list[dict]:
+    """Each paper-protocol record of ``question`` at 2 x ``size``: its f_gro(t), with the
+    continuation's checks appended where one was kept; f_gro at its own end and at the
+    fixed end ``cap_tc`` (the first check at or after it, as a cap ends a run: one capped
+    later is read there too); and how it ended."""
+    out = []
+    for outcome in sorted(records.glob(f"n{size}_{question}_b2_*/v*/b2_*/seed*/"
+                                       f"{rundir.OUTCOME}")):
+        o = json.loads(outcome.read_text())
+        where = outcome.parent.relative_to(records)
+        checks = read_csv(outcome.parent / rundir.CHECKS)
+        end_us = checks[-1]["time"] * 1e6
+        fixed_us = cap_tc * t_c_us(checks, json.loads((outcome.parent / rundir.META)
+                                                      .read_text()))
+        more = kept / where / rundir.CHECKS
+        if more.exists():
+            checks = checks + [r for r in read_csv(more) if r["step"] > checks[-1]["step"]]
+        t, f = series(checks, o["N_tar"], o["N_pro"])
+        at = next((k for k, x in enumerate(t) if x >= fixed_us * (1 - 1e-9)), len(t) - 1)
+        out.append(dict(record=str(where), B_off2=round(o["B_off"] ** 2, 4), seed=o["seed"],
+                        stop_reason=o["stop_reason"], end_us=end_us,
+                        f_gro_end=o["growth_efficiency"], continued=more.exists(),
+                        fixed_end_us=t[at], f_gro_fixed_end=f[at],
+                        reaches_fixed_end=t[-1] >= fixed_us * (1 - 1e-9),
+                        time_us=t, f_gro=f))
+    return out
+
+
+def mean_or_open(rows: list[dict], key: str) -> dict:
+    """<f_gro> of eq. (1) from ``key`` of each offset (seeds averaged) if all twelve are
+    in, else what the open ones must average for <f_gro> < 0."""
+    by = {}
+    for r in rows:                  # the twelfths exactly, as eq. (1)'s grid
+        by.setdefault(round(12 * r["B_off2"]) / 12, []).append(r[key])
+    b2 = sorted(by)
+    f = [sum(by[b]) / len(by[b]) for b in b2]
+    if protocol.is_paper_grid(b2):
+        return dict(mean_f_gro=float(b_off_average(b2, f, grazing=0.0)))
+    return dict(sign_open=what_the_rest_needs(b2, f))
+
+
+def figure(rows: list[dict], results: Path, cap_us: float, title: str) -> list[Path]:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7.5, 4.6))
+    for k, r in enumerate(sorted(rows, key=lambda r: r["B_off2"])):
+        color = plt.cm.viridis(r["B_off2"] / 0.95)
+        label = f"B_off^2 {protocol.twelfths(r['B_off2'], 1e-3)}"
+        ax.plot(r["time_us"], r["f_gro"], color=color, lw=1.2, label=label)
+        if r["continued"]:
+            ax.plot([r["end_us"]], [r["f_gro_end"]], "o", color=color, ms=5, mfc="none")
+    ax.axvline(cap_us, color="0.5", ls=":", lw=1)
+    ax.text(cap_us, 1.0, " fixed end", fontsize=7, va="top", color="0.4")
+    for t in (0.4, 0.8, 1.2, 1.6):
+        ax.axvline(t, color="0.9", lw=0.8, zorder=0)
+    ax.axhline(0, color="0.7", lw=0.8)
+    ax.set_xlabel("time (us); grey: the paper's snapshots, circle: where the settle rule "
+                  "ended the run", fontsize=8)
+    ax.set_ylabel("f_gro = (N_lar - N_tar) / N_pro")
+    ax.set_ylim(-1.05, 1.05)
+    ax.legend(fontsize=7, ncol=2, loc="lower left")
+    ax.set_title(f"{title}: f_gro against time, settled runs continued to the fixed end",
+                 fontsize=9)
+    fig.tight_layout()
+    return save(fig, results, "fig_fixed_end")
+
+
+def main(argv=None) -> int:
+    p = campaign_study_parser(__doc__)
+    p.add_argument("--question", default=None, help="default b (--quick: a)")
+    p.add_argument("--size", type=int, default=None, help="default 50000 (--quick: 24)")
+    p.add_argument("--cap", type=float, default=None,
+                   help=f"the fixed end, t_c (default {PAPER_CAP_TC:g}; --quick: {QUICK_CAP_TC:g})")
+    p.add_argument("--twelfths", type=int, nargs="+", default=None,
+                   help="continue only the offsets B_off^2 = k/12 of these k")
+    p.add_argument("--protocol-runs", type=Path, default=HERE / "runs" / "paper_protocol")
+    p.add_argument("--protocol-records", type=Path,
+                   default=HERE / "paper_protocol" / "records")
+    p.add_argument("--summary-only", action="store_true")
+    p.add_argument("--one", nargs=2, type=Path, help=argparse.SUPPRESS)
+    args = p.parse_args(argv)
+    for name, paper, quick in (("question", "b", "a"), ("size", 50000, 24),
+                               ("cap", PAPER_CAP_TC, QUICK_CAP_TC)):
+        if getattr(args, name) is None:
+            setattr(args, name, quick if args.quick else paper)
+    if args.one:                                 # one continuation, under mpirun
+        continue_run(args.one[0], args.one[1], args.cap)
+        return 0
+    runs, results = study_paths(args, "fixed_end")
+    kept = results / "records"
+    if not args.summary_only:
+        for run in to_continue(args.protocol_runs, args.size, args.question, args.cap,
+                               args.twelfths):
+            where = run.relative_to(args.protocol_runs)
+            if (kept / where / rundir.CHECKS).exists():
+                continue
+            cmd = [str(BIN / "python"), __file__, "--one", str(run), str(runs / where),
+                   "--cap", str(args.cap)]
+            if args.np > 1:
+                cmd = [str(BIN / "mpirun"), "-np", str(args.np)] + cmd
+            print(f"{where}: continued to {args.cap:g} t_c", flush=True)
+            if subprocess.run(cmd).returncode != 0:
+                raise SystemExit(f"{where}: the continuation stopped; run again to resume")
+            (kept / where).mkdir(parents=True, exist_ok=True)
+            for name in KEPT:                       # the checks last: the record's mark
+                shutil.copy2(runs / where / name, kept / where / f".{name}")
+            for name in KEPT:
+                (kept / where / f".{name}").rename(kept / where / name)
+    rows = offsets(args.protocol_records, kept, args.size, args.question, args.cap)
+    cap_us = max((r["fixed_end_us"] for r in rows), default=None)
+    done = dict(study="fixed_end", question=args.question, size=args.size,
+                cap_tc=args.cap, cap_us=cap_us, results=dict(offsets=[{k: v for k, v in r.items()
+                                       if k not in ("time_us", "f_gro")} for r in rows],
+                             settle_end=mean_or_open(rows, "f_gro_end"),
+                             fixed_end=mean_or_open(rows, "f_gro_fixed_end")))
+    if rows:
+        q = QUESTIONS[args.question]
+        done["figures"] = [p.name for p in figure(
+            rows, results, cap_us, f"{q['model']}, {q['v_col']:g} m/s, 2 x {args.size}")]
+    return write_summary(results, done)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
