@@ -1,8 +1,8 @@
 """Does f_gro still move after the settle rule ends a paper-size run? (issue 46, item 5)
 
 At 2 x 50000 the frictionless collisions at 39.8 m/s make one body that parts into two
-(2/12 at 1.63 us, 3/12 at 1.37 us, 6/12 at 0.69 us), and 4/12 parted twice (1.25 and
-1.7 us): the outcome moves on microsecond scales, while the settle rule watches 250 t_c
+(2/12 at 1.63 us, 3/12 at 1.37 us, 6/12 at 0.88 us), and 4/12 parted twice (1.23 and
+1.70 us): the outcome moves on microsecond scales, while the settle rule watches 250 t_c
 (68 ns). The paper's runs end at a time it does not state. This study puts every
 paper-size run of a question on one clock: each run the settle rule ended before the
 paper stage's cap (``paper_protocol.PAPER_CAP_TC``, 4.4 us) is continued from its
@@ -34,11 +34,14 @@ from common import BIN, campaign_study_parser, save, study_paths, write_summary
 from jkrdt import protocol, rundir
 from jkrdt.analysis.summary import b_off_average
 from jkrdt.analysis.tables import read_csv
+from jkrdt.stopping import SettleRule
 from paper_protocol import PAPER_CAP_TC, QUESTIONS, TWELFTHS_FIRST, what_the_rest_needs
 
 HERE = Path(__file__).resolve().parent
 #: a settle window no run reaches: the checks are written, the rule never ends the run
 WATCH_ONLY = 10 ** 9
+#: the settle rule's window (checks) the runs ended with (jkrdt.stopping.SettleRule)
+SETTLE_WINDOW = SettleRule().window
 #: the quick variant's fixed end (t_c): its head-on 2 x 24 runs settle by about 400 t_c
 QUICK_CAP_TC = 1200.0
 #: what each continued run's record holds
@@ -52,7 +55,6 @@ def continue_run(run: Path, out: Path, cap_tc: float) -> None:
     from mpi4py import MPI
 
     from jkrdt.session import Session
-    from jkrdt.stopping import SettleRule
 
     comm = MPI.COMM_WORLD
     rule = SettleRule(window=WATCH_ONLY, cap_tc=cap_tc)
@@ -111,7 +113,9 @@ def offsets(records: Path, kept: Path, size: int, question: str, cap_tc: float) 
     """Each paper-protocol record of ``question`` at 2 x ``size``: its f_gro(t), with the
     continuation's checks appended where one was kept; f_gro at its own end and at the
     fixed end ``cap_tc`` (the first check at or after it, as a cap ends a run: one capped
-    later is read there too); and how it ended."""
+    later is read there too); how it ended, and how much the largest fragment's gyration
+    radius grew over the settle rule's last window there (a body still being pulled apart
+    by a neck, which the rule does not watch)."""
     out = []
     for outcome in sorted(records.glob(f"n{size}_{question}_b2_*/v*/b2_*/seed*/"
                                        f"{rundir.OUTCOME}")):
@@ -121,6 +125,9 @@ def offsets(records: Path, kept: Path, size: int, question: str, cap_tc: float) 
         end_us = checks[-1]["time"] * 1e6
         fixed_us = cap_tc * t_c_us(checks, json.loads((outcome.parent / rundir.META)
                                                       .read_text()))
+        window = checks[-1 - SETTLE_WINDOW:]        # the settle rule's window at the end
+        r_g = [c["gyration_radius_largest"] for c in (window[0], window[-1])]
+        stretch = r_g[1] / r_g[0] - 1 if r_g[0] > 0 else None    # None: one grain
         more = kept / where / rundir.CHECKS
         if more.exists():
             checks = checks + [r for r in read_csv(more) if r["step"] > checks[-1]["step"]]
@@ -128,8 +135,9 @@ def offsets(records: Path, kept: Path, size: int, question: str, cap_tc: float) 
         at = next((k for k, x in enumerate(t) if x >= fixed_us * (1 - 1e-9)), len(t) - 1)
         out.append(dict(record=str(where), B_off2=round(o["B_off"] ** 2, 4), seed=o["seed"],
                         stop_reason=o["stop_reason"], end_us=end_us,
-                        f_gro_end=o["growth_efficiency"], continued=more.exists(),
-                        fixed_end_us=t[at], f_gro_fixed_end=f[at],
+                        f_gro_end=o["growth_efficiency"], r_g_change_at_end=stretch,
+                        continued=more.exists(),
+                        fixed_us=fixed_us, fixed_end_us=t[at], f_gro_fixed_end=f[at],
                         reaches_fixed_end=t[-1] >= fixed_us * (1 - 1e-9),
                         time_us=t, f_gro=f))
     return out
@@ -137,7 +145,9 @@ def offsets(records: Path, kept: Path, size: int, question: str, cap_tc: float) 
 
 def mean_or_open(rows: list[dict], key: str) -> dict:
     """<f_gro> of eq. (1) from ``key`` of each offset (seeds averaged) if all twelve are
-    in, else what the open ones must average for <f_gro> < 0."""
+    in, else what the open ones must average for <f_gro> < 0 (none: nothing to say)."""
+    if not rows:
+        return {}
     by = {}
     for r in rows:                  # the twelfths exactly, as eq. (1)'s grid
         by.setdefault(round(12 * r["B_off2"]) / 12, []).append(r[key])
@@ -156,13 +166,14 @@ def figure(rows: list[dict], results: Path, cap_us: float, title: str) -> list[P
 
     fig, ax = plt.subplots(figsize=(7.5, 4.6))
     for k, r in enumerate(sorted(rows, key=lambda r: r["B_off2"])):
-        color = plt.cm.viridis(r["B_off2"] / 0.95)
+        color, style = plt.cm.tab10(k % 10), ("-", "--")[k // 10]
         label = f"B_off^2 {protocol.twelfths(r['B_off2'], 1e-3)}"
-        ax.plot(r["time_us"], r["f_gro"], color=color, lw=1.2, label=label)
+        ax.plot(r["time_us"], r["f_gro"], color=color, ls=style, lw=1.2, label=label)
         if r["continued"]:
             ax.plot([r["end_us"]], [r["f_gro_end"]], "o", color=color, ms=5, mfc="none")
     ax.axvline(cap_us, color="0.5", ls=":", lw=1)
-    ax.text(cap_us, 1.0, " fixed end", fontsize=7, va="top", color="0.4")
+    ax.text(cap_us, 1.0, "fixed end ", fontsize=7, va="top", ha="right", color="0.4")
+    ax.set_xlim(0, cap_us * 1.02)
     for t in (0.4, 0.8, 1.2, 1.6):
         ax.axvline(t, color="0.9", lw=0.8, zorder=0)
     ax.axhline(0, color="0.7", lw=0.8)
@@ -175,6 +186,29 @@ def figure(rows: list[dict], results: Path, cap_us: float, title: str) -> list[P
                  fontsize=9)
     fig.tight_layout()
     return save(fig, results, "fig_fixed_end")
+
+
+def table(rows: list[dict], done: dict) -> list[str]:
+    """Each offset's f_gro where its run ended and at the fixed end, and <f_gro> at both."""
+    lines = ["  B_off^2  ended             f_gro  r_g over its last window  f_gro at "
+             f"{done['cap_tc']:g} t_c"]
+    for r in sorted(rows, key=lambda r: r["B_off2"]):
+        fixed = (f"{r['f_gro_fixed_end']:+.3f}" + ("" if r["continued"] or r["stop_reason"]
+                                                   != "settled" else " (not continued)"))
+        stretch = ("      -" if r["r_g_change_at_end"] is None
+                   else f"{100 * r['r_g_change_at_end']:+6.2f} %")
+        lines.append(f"  {protocol.twelfths(r['B_off2'], 1e-3):7s}  {r['stop_reason']:8s} "
+                     f"{r['end_us']:4.2f} us {r['f_gro_end']:+.3f}  {stretch}"
+                     f"                  {fixed}")
+    for end in ("settle_end", "fixed_end"):
+        m = done["results"][end]
+        if "mean_f_gro" in m:
+            lines.append(f"  <f_gro> at the {end.replace('_', ' ')}: {m['mean_f_gro']:+.3f}")
+        elif m.get("sign_open"):
+            lines.append(f"  at the {end.replace('_', ' ')}, <f_gro> < 0 needs "
+                         f"{' '.join(m['sign_open']['to_run'])} to average below "
+                         f"{m['sign_open']['rest_must_average_below']:+.3f}")
+    return lines
 
 
 def main(argv=None) -> int:
@@ -219,12 +253,16 @@ def main(argv=None) -> int:
             for name in KEPT:
                 (kept / where / f".{name}").rename(kept / where / name)
     rows = offsets(args.protocol_records, kept, args.size, args.question, args.cap)
-    cap_us = max((r["fixed_end_us"] for r in rows), default=None)
+    cap_us = max((r["fixed_us"] for r in rows), default=None)
+    twelve = len(QUESTIONS[args.question]["b_off2"]) == 12    # eq. (1) over the grid
     done = dict(study="fixed_end", question=args.question, size=args.size,
-                cap_tc=args.cap, cap_us=cap_us, results=dict(offsets=[{k: v for k, v in r.items()
-                                       if k not in ("time_us", "f_gro")} for r in rows],
-                             settle_end=mean_or_open(rows, "f_gro_end"),
-                             fixed_end=mean_or_open(rows, "f_gro_fixed_end")))
+                cap_tc=args.cap, cap_us=cap_us, results=dict(
+                    offsets=[{k: v for k, v in r.items() if k not in ("time_us", "f_gro")}
+                             for r in rows],
+                    settle_end=mean_or_open(rows, "f_gro_end") if twelve else {},
+                    fixed_end=mean_or_open([r for r in rows if r["reaches_fixed_end"]],
+                                           "f_gro_fixed_end") if twelve else {}))
+    print("\n".join(table(rows, done)))
     if rows:
         q = QUESTIONS[args.question]
         done["figures"] = [p.name for p in figure(
