@@ -66,6 +66,8 @@ def continue_run(run: Path, out: Path, cap_tc: float) -> None:
         point = rundir.resume_point(out, end) if (out / rundir.LOG).exists() else None
         if point is not None:
             rundir.cut_back(out, point[1])
+        else:                       # cut off before its first restart file: anew
+            rundir.clear_run(out)
     point = comm.bcast(point, root=0)
     if point is None:
         start = json.loads((run / rundir.OUTCOME).read_text())["stop_step"]
@@ -76,6 +78,16 @@ def continue_run(run: Path, out: Path, cap_tc: float) -> None:
                  variables=dict(steps=end - start)) as s:
         s.run_until_settled(progress=False)
         s.finish()
+
+
+def keep(run: Path, record: Path) -> None:
+    """A finished continuation's record (KEPT), copied whole: its checks.csv, the mark of a
+    kept record, is renamed into place last."""
+    record.mkdir(parents=True, exist_ok=True)
+    for name in KEPT:
+        shutil.copy2(run / name, record / f".{name}")
+    for name in sorted(KEPT, key=lambda n: n == rundir.CHECKS):
+        (record / f".{name}").rename(record / name)
 
 
 def to_continue(runs: Path, size: int, question: str, cap_tc: float,
@@ -240,6 +252,9 @@ def main(argv=None) -> int:
             where = run.relative_to(args.protocol_runs)
             if (kept / where / rundir.CHECKS).exists():
                 continue
+            if (runs / where / rundir.FINAL_RESTART).exists():     # ended, not yet kept
+                keep(runs / where, kept / where)
+                continue
             cmd = [str(BIN / "python"), __file__, "--one", str(run), str(runs / where),
                    "--cap", str(args.cap)]
             if args.np > 1:
@@ -247,11 +262,7 @@ def main(argv=None) -> int:
             print(f"{where}: continued to {args.cap:g} t_c", flush=True)
             if subprocess.run(cmd).returncode != 0:
                 raise SystemExit(f"{where}: the continuation stopped; run again to resume")
-            (kept / where).mkdir(parents=True, exist_ok=True)
-            for name in KEPT:                       # the checks last: the record's mark
-                shutil.copy2(runs / where / name, kept / where / f".{name}")
-            for name in KEPT:
-                (kept / where / f".{name}").rename(kept / where / name)
+            keep(runs / where, kept / where)
     rows = offsets(args.protocol_records, kept, args.size, args.question, args.cap)
     cap_us = max((r["fixed_us"] for r in rows), default=None)
     twelve = len(QUESTIONS[args.question]["b_off2"]) == 12    # eq. (1) over the grid
