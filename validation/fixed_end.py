@@ -35,7 +35,8 @@ from jkrdt import protocol, rundir
 from jkrdt.analysis.summary import b_off_average
 from jkrdt.analysis.tables import read_csv
 from jkrdt.stopping import SettleRule
-from paper_protocol import PAPER_CAP_TC, QUESTIONS, TWELFTHS_FIRST, what_the_rest_needs
+from paper_protocol import (PAPER_CAP_TC, QUESTIONS, SNAPSHOTS_US, TWELFTHS_FIRST,
+                            what_the_rest_needs)
 
 HERE = Path(__file__).resolve().parent
 #: a settle window no run reaches: the checks are written, the rule never ends the run
@@ -186,7 +187,7 @@ def figure(rows: list[dict], results: Path, cap_us: float, title: str) -> list[P
     ax.axvline(cap_us, color="0.5", ls=":", lw=1)
     ax.text(cap_us, 1.0, "fixed end ", fontsize=7, va="top", ha="right", color="0.4")
     ax.set_xlim(0, cap_us * 1.02)
-    for t in (0.4, 0.8, 1.2, 1.6):
+    for t in SNAPSHOTS_US:
         ax.axvline(t, color="0.9", lw=0.8, zorder=0)
     ax.axhline(0, color="0.7", lw=0.8)
     ax.set_xlabel("time (us); grey: the paper's snapshots, circle: where the settle rule "
