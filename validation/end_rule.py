@@ -17,11 +17,13 @@ validation/paper_protocol/end_rule.json.
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import sys
 from pathlib import Path
 
+from jkrdt import rundir
+from jkrdt.analysis.outcome import from_checks
+from jkrdt.analysis.tables import read_csv
 from paper_protocol import PAPER_CAP_TC
 
 HERE = Path(__file__).resolve().parent
@@ -31,15 +33,13 @@ ALLOWED = 0.02
 
 
 def series(run: Path) -> tuple[list[float], list[int], list[int], dict]:
-    """Time (s), N_lar and the number of fragments at every settle check (a step written
-    twice counts once, as written last), and the run's collision.json with its t_c (s)."""
-    latest = {int(r["step"]): r for r in csv.DictReader(open(run / "checks.csv"))}
-    rows = [latest[s] for s in sorted(latest)]
-    meta = json.loads((run / "collision.json").read_text())
-    last = max(latest)
-    meta["t_c"] = float(latest[last]["time"]) / last / meta["dt_over_tc"]
-    return ([float(r["time"]) for r in rows], [int(r["n_largest"]) for r in rows],
-            [int(r["n_fragments"]) for r in rows], meta)
+    """Time (s), N_lar and the number of fragments at every settle check (``from_checks``:
+    a step written twice counts once), and the run's collision.json with its t_c (s)."""
+    meta = rundir.read_metadata(run)
+    meta["t_c"] = rundir.from_metadata(meta).scales.t_c
+    rows = from_checks(read_csv(run / rundir.CHECKS), meta["N_tar"], meta["N_pro"])
+    return ([r["time"] for r in rows], [r["n_largest"] for r in rows],
+            [r["n_fragments"] for r in rows], meta)
 
 
 def capped(runs: list[Path], cap_tc: float) -> dict:

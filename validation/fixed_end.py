@@ -32,7 +32,8 @@ from pathlib import Path
 
 from common import BIN, campaign_study_parser, save, study_paths, write_summary
 from jkrdt import protocol, rundir
-from jkrdt.analysis.summary import b_off_average
+from jkrdt.analysis.outcome import from_checks
+from jkrdt.analysis.summary import b_off_average, b_off_groups
 from jkrdt.analysis.tables import read_csv
 from jkrdt.stopping import SettleRule
 from paper_protocol import (PAPER_CAP_TC, QUESTIONS, SNAPSHOTS_US, TWELFTHS_FIRST,
@@ -110,18 +111,6 @@ def to_continue(runs: Path, size: int, question: str, cap_tc: float,
     return out
 
 
-def series(checks: list[dict], n_tar: int, n_pro: int) -> tuple[list[float], list[float]]:
-    """Time (us) and f_gro at every settle check, a step written twice counted once."""
-    latest = {int(r["step"]): r for r in checks}
-    rows = [latest[s] for s in sorted(latest)]
-    return ([r["time"] * 1e6 for r in rows], [(r["n_largest"] - n_tar) / n_pro for r in rows])
-
-
-def t_c_us(checks: list[dict], meta: dict) -> float:
-    """t_c (us) of a run: its time step (time over step at its last check) over dt / t_c."""
-    return checks[-1]["time"] / checks[-1]["step"] / meta["dt_over_tc"] * 1e6
-
-
 def offsets(records: Path, kept: Path, size: int, question: str, cap_tc: float) -> list[dict]:
     """Each paper-protocol record of ``question`` at 2 x ``size``: its f_gro(t), with the
     continuation's checks appended where one was kept; f_gro at its own end and at the
@@ -134,19 +123,21 @@ def offsets(records: Path, kept: Path, size: int, question: str, cap_tc: float) 
                                        f"{rundir.OUTCOME}")):
         o = json.loads(outcome.read_text())
         where = outcome.parent.relative_to(records)
-        checks = read_csv(outcome.parent / rundir.CHECKS)
+        checks = from_checks(read_csv(outcome.parent / rundir.CHECKS), o["N_tar"], o["N_pro"])
         end_us = checks[-1]["time"] * 1e6
-        fixed_us = cap_tc * t_c_us(checks, json.loads((outcome.parent / rundir.META)
-                                                      .read_text()))
+        fixed_us = cap_tc * rundir.read(outcome.parent).scales.t_c * 1e6
         window = checks[-1 - SETTLE_WINDOW:]        # the settle rule's window at the end
         r_g = [c["gyration_radius_largest"] for c in (window[0], window[-1])]
         stretch = r_g[1] / r_g[0] - 1 if r_g[0] > 0 else None    # None: one grain
         more = kept / where / rundir.CHECKS
         if more.exists():
-            checks = checks + [r for r in read_csv(more) if r["step"] > checks[-1]["step"]]
-        t, f = series(checks, o["N_tar"], o["N_pro"])
+            checks += [r for r in from_checks(read_csv(more), o["N_tar"], o["N_pro"])
+                       if r["step"] > checks[-1]["step"]]
+        t = [r["time"] * 1e6 for r in checks]
+        f = [r["growth_efficiency"] for r in checks]
         at = next((k for k, x in enumerate(t) if x >= fixed_us * (1 - 1e-9)), len(t) - 1)
-        out.append(dict(record=str(where), B_off2=round(o["B_off"] ** 2, 4), seed=o["seed"],
+        out.append(dict(record=str(where), B_off=o["B_off"], B_off2=round(o["B_off"] ** 2, 4),
+                        seed=o["seed"],
                         stop_reason=o["stop_reason"], end_us=end_us,
                         f_gro_end=o["growth_efficiency"], r_g_change_at_end=stretch,
                         continued=more.exists(),
@@ -161,11 +152,7 @@ def mean_or_open(rows: list[dict], key: str) -> dict:
     in, else what the open ones must average for <f_gro> < 0 (none: nothing to say)."""
     if not rows:
         return {}
-    by = {}
-    for r in rows:                  # the twelfths exactly, as eq. (1)'s grid
-        by.setdefault(round(12 * r["B_off2"]) / 12, []).append(r[key])
-    b2 = sorted(by)
-    f = [sum(by[b]) / len(by[b]) for b in b2]
+    b2, f = b_off_groups(rows, lambda r: r[key])
     if protocol.is_paper_grid(b2):
         return dict(mean_f_gro=float(b_off_average(b2, f, grazing=0.0)))
     return dict(sign_open=what_the_rest_needs(b2, f))
