@@ -160,10 +160,10 @@ def save(fig, results: Path, stem: str) -> list[Path]:
     return out
 
 
-def write_summary(results: Path, summary: dict) -> int:
-    """A study's summary.json in ``results``, its "results" part printed; 0, the study's
-    exit status."""
-    (results / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+def write_summary(results: Path, summary: dict, name: str = "summary.json") -> int:
+    """A study's summary (``name``) in ``results``, its "results" part printed; 0, the
+    study's exit status."""
+    (results / name).write_text(json.dumps(summary, indent=2) + "\n")
     print(json.dumps(summary["results"], indent=1))
     return 0
 

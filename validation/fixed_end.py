@@ -18,7 +18,9 @@ restart file). As each ends, its checks.csv is kept below RESULTS/records/<campa
 the results come from the records alone: each offset's f_gro(t) from the original run's
 checks and its continuation's, f_gro at the settle end and at the fixed end, <f_gro> of
 eq. (1) at both ends where the twelve offsets are in (else what the open offsets must
-average for <f_gro> < 0), and fig_fixed_end (f_gro against time, one line per offset).
+average for <f_gro> < 0), and fig_fixed_end (f_gro against time, one line per run).
+Question b at 2 x 50000 writes summary.json and fig_fixed_end; any other (``--question``,
+``--size``) writes summary_<question>_n<size>.json and fig_fixed_end_<question>_n<size>.
 """
 
 from __future__ import annotations
@@ -158,16 +160,19 @@ def mean_or_open(rows: list[dict], key: str) -> dict:
     return dict(sign_open=what_the_rest_needs(b2, f))
 
 
-def figure(rows: list[dict], results: Path, cap_us: float, title: str) -> list[Path]:
+def figure(rows: list[dict], results: Path, cap_us: float, title: str,
+           tag: str = "") -> list[Path]:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(7.5, 4.6))
-    for k, r in enumerate(sorted(rows, key=lambda r: r["B_off2"])):
+    seeds = len({r["seed"] for r in rows}) > 1
+    for k, r in enumerate(sorted(rows, key=lambda r: (r["B_off2"], r["seed"]))):
         color, style = plt.cm.tab10(k % 10), ("-", "--")[k // 10]
-        label = f"B_off^2 {protocol.twelfths(r['B_off2'], 1e-3)}"
+        label = f"B_off^2 {protocol.twelfths(r['B_off2'], 1e-3)}" + \
+            (f", seed {r['seed']}" if seeds else "")
         ax.plot(r["time_us"], r["f_gro"], color=color, ls=style, lw=1.2, label=label)
         if r["continued"]:
             ax.plot([r["end_us"]], [r["f_gro_end"]], "o", color=color, ms=5, mfc="none")
@@ -185,7 +190,7 @@ def figure(rows: list[dict], results: Path, cap_us: float, title: str) -> list[P
     ax.set_title(f"{title}: f_gro against time, settled runs continued to the fixed end",
                  fontsize=9)
     fig.tight_layout()
-    return save(fig, results, "fig_fixed_end")
+    return save(fig, results, "fig_fixed_end" + tag)
 
 
 def table(rows: list[dict], done: dict) -> list[str]:
@@ -254,6 +259,9 @@ def main(argv=None) -> int:
     rows = offsets(args.protocol_records, kept, args.size, args.question, args.cap)
     cap_us = max((r["fixed_us"] for r in rows), default=None)
     twelve = len(QUESTIONS[args.question]["b_off2"]) == 12    # eq. (1) over the grid
+    # the paper-size question b is the study's own; any other question or size is named
+    tag = "" if (args.question, args.size) == ("b", 50000) or args.quick else \
+        f"_{args.question}_n{args.size}"
     done = dict(study="fixed_end", question=args.question, size=args.size,
                 cap_tc=args.cap, cap_us=cap_us, results=dict(
                     offsets=[{k: v for k, v in r.items() if k not in ("time_us", "f_gro")}
@@ -265,8 +273,8 @@ def main(argv=None) -> int:
     if rows:
         q = QUESTIONS[args.question]
         done["figures"] = [p.name for p in figure(
-            rows, results, cap_us, f"{q['model']}, {q['v_col']:g} m/s, 2 x {args.size}")]
-    return write_summary(results, done)
+            rows, results, cap_us, f"{q['model']}, {q['v_col']:g} m/s, 2 x {args.size}", tag)]
+    return write_summary(results, done, f"summary{tag}.json")
 
 
 if __name__ == "__main__":
