@@ -10,20 +10,27 @@ c = 1e-4 is that part of the rule every run here used). For each committed
 stopped and f_gro there against f_gro at the run's real end. It does the same for a lower
 cap (the paper stage's, ``paper_protocol.PAPER_CAP_TC``): a run stops at the first check
 at or after it. The issue allows such a rule for its campaigns only if it moves no
-committed paper-size f_gro by more than 0.02. Reads the records only; writes
-validation/paper_protocol/end_rule.json.
+committed paper-size f_gro by more than 0.02.
+
+The other way round, it lists every committed record (of every study that keeps them)
+that the settle rule ended while the largest fragment's gyration radius r_g was still
+growing by more than the rule's own tolerance (1 %) over its last window: a body being
+pulled apart by a neck, which the rule does not watch (``fixed_end``), per study and
+size. Reads the records only; writes validation/paper_protocol/end_rule.json.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import re
 import sys
 from pathlib import Path
 
 from jkrdt import rundir
 from jkrdt.analysis.outcome import from_checks
 from jkrdt.analysis.tables import read_csv
+from jkrdt.stopping import SettleRule
 from paper_protocol import PAPER_CAP_TC
 
 HERE = Path(__file__).resolve().parent
@@ -62,6 +69,37 @@ def capped(runs: list[Path], cap_tc: float) -> dict:
               f"{r['f_gro_stop']:+.3f}; the run ended at {r['end_ns']:.0f} ns "
               f"({r['end_tc']:.0f} t_c) with {r['f_gro_end']:+.3f}")
     return rule
+
+
+def stretching(records: list[Path], rule: SettleRule = SettleRule()) -> dict:
+    """Per campaign of each folder of ``records`` (a paper_protocol question and size
+    with all its offsets): how many settled runs there are, and each whose largest
+    fragment's r_g grew by more than ``rule.tolerance`` over the rule's last window
+    (``rule.window`` checks) when the rule ended it."""
+    out = {}
+    for checks in sorted(c for top in records for c in top.glob("**/checks.csv")):
+        o = rundir.read_outcome(checks.parent)     # None: a continuation's checks alone
+        if o is None or o.get("stop_reason") != "settled":
+            continue
+        rows = from_checks(read_csv(checks), o["N_tar"], o["N_pro"])[-1 - rule.window:]
+        r_g = [r["gyration_radius_largest"] for r in (rows[0], rows[-1])]
+        grew = r_g[1] / r_g[0] - 1 if r_g[0] > 0 else 0.0    # 0: one grain
+        campaign = re.sub(r"_b2_[0-9.]+$", "", named(checks.parent).split("/v")[0])
+        folder = out.setdefault(campaign, dict(settled=0, stretching=[]))
+        folder["settled"] += 1
+        if grew > rule.tolerance:
+            folder["stretching"].append(dict(
+                run=named(checks.parent), B_off2=round(o["B_off"] ** 2, 4), seed=o["seed"],
+                model=o["model"], f_gro=o["growth_efficiency"], n_largest=o["n_largest"],
+                r_g_growth=grew))
+    print(f"settled runs whose largest fragment's r_g grew by more than "
+          f"{100 * rule.tolerance:g} % over the rule's last window:")
+    for folder, v in out.items():
+        print(f"  {folder}: {len(v['stretching'])} of {v['settled']}" + "".join(
+            f"\n    B_off^2 {r['B_off2']:.4f} seed {r['seed']}: f_gro {r['f_gro']:+.3f}, "
+            f"N_lar {r['n_largest']}, r_g {100 * r['r_g_growth']:+.1f} %"
+            for r in v["stretching"]))
+    return out
 
 
 def named(run: Path) -> str:
@@ -111,6 +149,7 @@ def main(argv=None) -> int:
             print(f"  B_off^2 {r['B_off'] ** 2:.4f}: stops {stop}; the run ended at "
                   f"{r['end_ns']:.0f} ns with {r['f_gro_end']:+.3f}")
     out["caps"] = [capped(runs, PAPER_CAP_TC)]
+    out["stretching_at_end"] = stretching(sorted(HERE.glob("*/records")))
     (HERE / "paper_protocol" / "end_rule.json").write_text(json.dumps(out, indent=1) + "\n")
     return 0
 
