@@ -95,10 +95,10 @@ def keep(run: Path, record: Path) -> None:
 
 
 def to_continue(runs: Path, size: int, question: str, cap_tc: float,
-                twelfths=None) -> list[Path]:
+                twelfths=None, seeds=None) -> list[Path]:
     """The runs of ``question`` at 2 x ``size`` that the settle rule ended before
     ``cap_tc``, in TWELFTHS_FIRST's order (their final.restart at hand); ``twelfths``:
-    only the offsets B_off^2 = k/12 of these k."""
+    only the offsets B_off^2 = k/12 of these k; ``seeds``: only these seeds."""
     out = []
     for b2 in TWELFTHS_FIRST:
         if twelfths is not None and round(12 * b2) not in twelfths:
@@ -108,6 +108,8 @@ def to_continue(runs: Path, size: int, question: str, cap_tc: float,
             if not (outcome.exists() and (run / rundir.FINAL_RESTART).exists()):
                 continue
             o = json.loads(outcome.read_text())
+            if seeds is not None and o["seed"] not in seeds:
+                continue
             if o.get("stop_reason") == "settled" and o["time_end_over_tc"] < cap_tc:
                 out.append(run)
     return out
@@ -222,6 +224,8 @@ def main(argv=None) -> int:
     p.add_argument("--size", type=int, default=None, help="default 50000 (--quick: 24)")
     p.add_argument("--cap", type=float, default=None,
                    help=f"the fixed end, t_c (default {PAPER_CAP_TC:g}; --quick: {QUICK_CAP_TC:g})")
+    p.add_argument("--seeds", type=int, nargs="+", default=None,
+                   help="continue only the runs of these seeds")
     p.add_argument("--twelfths", type=int, nargs="+", default=None,
                    help="continue only the offsets B_off^2 = k/12 of these k")
     p.add_argument("--protocol-runs", type=Path, default=HERE / "runs" / "paper_protocol")
@@ -241,7 +245,7 @@ def main(argv=None) -> int:
     kept = results / "records"
     if not args.summary_only:
         for run in to_continue(args.protocol_runs, args.size, args.question, args.cap,
-                               args.twelfths):
+                               args.twelfths, args.seeds):
             where = run.relative_to(args.protocol_runs)
             if (kept / where / rundir.CHECKS).exists():
                 continue
