@@ -25,7 +25,7 @@ from jkrdt.ledger import CHANNELS, contact_events, energy_budget, energy_error
 from jkrdt.stopping import ENERGY_WARN, STOP_WORDS
 
 from .dumps import atoms_universe
-from .outcome import CollisionOutcome, energy_scalings, from_checks
+from .outcome import CollisionOutcome, energy_scalings, from_checks, stretching
 from .plots import energy_partition, outcome, timeline
 from .summary import diagnostics
 from .tables import read_csv, write_csv
@@ -126,6 +126,9 @@ def analyse_run(run, tolerance: float | None = None, plots: bool = True,
                last_step=last_step, last_frame_step=last_frame,
                outcome_from="atom frame" if last_step == last_frame else "settle check",
                settled=status.stop_reason == "settled", problem=status.problem)
+    rule = rundir.settle_window(text) if text is not None else None
+    if status.stop_reason == "settled" and rule:    # the largest's shape over the last window
+        out["shape_at_end"] = stretching(table, *rule)
     if budget is not None:
         out.update(energies_at(budget, thermo, last_step, meta["E_imp"], s.t_c))
     write_csv(run / rundir.FRAMES, rows)
@@ -227,6 +230,13 @@ def summary_text(out: dict) -> str:
                      "where N_cum and the picture are")
     if out.get("problem"):
         lines.append(f"  WARNING                   {out['problem']}; partial outcome")
+    shape = out.get("shape_at_end")
+    if shape and shape["stretching"]:
+        lines.append(f"  WARNING                   the largest body's r_g grew "
+                     f"{100 * shape['r_g_growth']:.1f} % over the settle rule's last "
+                     f"{shape['window']} checks: a neck may still part it and lower f_gro; "
+                     "read the outcome at a later, fixed time (the manual's fix "
+                     "jkr/dt/settle, 'What the rule does not watch')")
     if "kinetic_left" in out:
         lines.append(f"kinetic energy left / E_imp {out['kinetic_left']:.3f}"
                      + (f"  ({out['kinetic_departed']:.3f} in departed fragments)"

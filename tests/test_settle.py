@@ -19,6 +19,7 @@ from jkrdt import rundir
 
 from jkrdt import scene as scene_module
 from jkrdt.analysis.summary import summarise
+from jkrdt.analysis.tables import read_csv
 from jkrdt.analysis.dumps import frames
 from jkrdt.analysis.fragments import from_contacts
 from jkrdt.analysis.run import RunNotComplete, analyse_run
@@ -196,3 +197,41 @@ def test_truncated_dump_is_refused_unless_partial(settled, tmp_path, cut):
     assert out["stop_reason"] == "cut off" and out["last_step"] < out["stop_step"]
     gc.collect()
     assert copies() <= before, "the readable copy of a cut-off dump outlived its reader"
+
+
+def test_a_frictionless_hinge_opening_counts_as_settled_and_the_outcome_says_so(tmp_path):
+    """What the rule does not watch: shape. Three frictionless grains bent at 90 degrees
+    (two contacts at the equilibrium distance 2R - delta_0), the end grains moving apart
+    at 1 m/s across their arms, open like a hinge: no rolling or sliding resistance, so
+    the contacts, N_lar = 3 and the fragments hold still and nothing is dissipated, and
+    the rule ends the run after one window while the hinge is still opening (r_g of
+    three grains goes from 2/3 d at 90 degrees towards sqrt(2/3) d straight). The outcome
+    measures the growth of r_g over the rule's window from checks.csv and flags the body
+    as still stretching, with a warning in the summary."""
+    from jkrdt.analysis.run import summary_text
+    from jkrdt.collision import Collision
+
+    d = 2 * R - S.delta0
+    u = 1.0
+    x = np.array([[0.0, 0.0, 0.0], [d, 0.0, 0.0], [0.0, d, 0.0]])
+    v = np.array([[0.0, 0.0, 0.0], [0.0, -u, 0.0], [-u, 0.0, 0.0]])
+    scene = scene_module.Scene(ICE, 2, 1, v_col=u, seed=1, kind="bpca", dim=3,
+                               model="frictionless")
+    run = rundir.write(tmp_path / "hinge", scene, placed=Collision(
+        x=x, v=v, body=np.array([1, 1, 2]), radius=R, meta=dict(b=0.0, gap=0.0)))
+    with Session(run, run, every=1, settle=RULE, variables=dict(frames=1)) as s:
+        s.run_until_settled(progress=False)
+        assert s.stop_reason == "settled"
+    out = analyse_run(run, plots=False)
+    assert out["n_largest"] == 3 and out["contacts_end"] == 2
+    assert out["dissipated_fraction"] == 0.0
+    rows = read_csv(run / rundir.CHECKS)
+    assert len(rows) == RULE.window + 1                 # settled at the first full window
+    r_g = [r["gyration_radius_largest"] for r in rows]
+    assert r_g[0] == pytest.approx(2 / 3 * d, rel=1e-3)           # 90 degrees at the start
+    assert all(b > a for a, b in zip(r_g, r_g[1:])) and r_g[-1] < np.sqrt(2 / 3) * d
+    shape = out["shape_at_end"]
+    assert shape["window"] == RULE.window
+    assert shape["r_g_growth"] == pytest.approx(r_g[-1] / r_g[0] - 1, rel=1e-12)
+    assert shape["r_g_growth"] > RULE.tolerance and shape["stretching"] is True
+    assert "a neck may still part it" in summary_text(out)

@@ -29,6 +29,7 @@ from pathlib import Path
 
 from jkrdt import rundir
 from jkrdt.analysis.outcome import from_checks
+from jkrdt.analysis.outcome import stretching as stretching_at
 from jkrdt.analysis.tables import read_csv
 from jkrdt.stopping import SettleRule
 from paper_protocol import PAPER_CAP_TC
@@ -81,9 +82,9 @@ def stretching(records: list[Path], rule: SettleRule = SettleRule()) -> dict:
         o = rundir.read_outcome(checks.parent)     # None: a continuation's checks alone
         if o is None or o.get("stop_reason") != "settled":
             continue
-        rows = from_checks(read_csv(checks), o["N_tar"], o["N_pro"])[-1 - rule.window:]
-        r_g = [r["gyration_radius_largest"] for r in (rows[0], rows[-1])]
-        grew = r_g[1] / r_g[0] - 1 if r_g[0] > 0 else 0.0    # 0: one grain
+        shape = stretching_at(from_checks(read_csv(checks), o["N_tar"], o["N_pro"]),
+                              rule.window, rule.tolerance)
+        grew = shape["r_g_growth"] if shape else 0.0    # 0: a largest of one grain
         campaign = re.sub(r"_b2_[0-9.]+$", "", named(checks.parent).split("/v")[0])
         folder = out.setdefault(campaign, dict(settled=0, stretching=[]))
         folder["settled"] += 1

@@ -34,7 +34,7 @@ from pathlib import Path
 
 from common import BIN, campaign_study_parser, save, study_paths, write_summary
 from jkrdt import protocol, rundir
-from jkrdt.analysis.outcome import from_checks
+from jkrdt.analysis.outcome import from_checks, stretching
 from jkrdt.analysis.summary import b_off_average, b_off_groups
 from jkrdt.analysis.tables import read_csv
 from jkrdt.stopping import SettleRule
@@ -44,8 +44,8 @@ from paper_protocol import (PAPER_CAP_TC, QUESTIONS, SNAPSHOTS_US, TWELFTHS_FIRS
 HERE = Path(__file__).resolve().parent
 #: a settle window no run reaches: the checks are written, the rule never ends the run
 WATCH_ONLY = 10 ** 9
-#: the settle rule's window (checks) the runs ended with (jkrdt.stopping.SettleRule)
-SETTLE_WINDOW = SettleRule().window
+#: the settle rule the runs ended with (its window and tolerance)
+SETTLE = SettleRule()
 #: the quick variant's fixed end (t_c): its head-on 2 x 24 runs settle by about 400 t_c
 QUICK_CAP_TC = 1200.0
 #: what each continued run's record holds
@@ -130,9 +130,7 @@ def offsets(records: Path, kept: Path, size: int, question: str, cap_tc: float) 
         checks = from_checks(read_csv(outcome.parent / rundir.CHECKS), o["N_tar"], o["N_pro"])
         end_us = checks[-1]["time"] * 1e6
         fixed_us = cap_tc * rundir.read(outcome.parent).scales.t_c * 1e6
-        window = checks[-1 - SETTLE_WINDOW:]        # the settle rule's window at the end
-        r_g = [c["gyration_radius_largest"] for c in (window[0], window[-1])]
-        stretch = r_g[1] / r_g[0] - 1 if r_g[0] > 0 else None    # None: one grain
+        shape = stretching(checks, SETTLE.window, SETTLE.tolerance)     # None: one grain
         more = kept / where / rundir.CHECKS
         if more.exists():
             checks += [r for r in from_checks(read_csv(more), o["N_tar"], o["N_pro"])
@@ -143,7 +141,8 @@ def offsets(records: Path, kept: Path, size: int, question: str, cap_tc: float) 
         out.append(dict(record=str(where), B_off=o["B_off"], B_off2=round(o["B_off"] ** 2, 4),
                         seed=o["seed"],
                         stop_reason=o["stop_reason"], end_us=end_us,
-                        f_gro_end=o["growth_efficiency"], r_g_change_at_end=stretch,
+                        f_gro_end=o["growth_efficiency"],
+                        r_g_change_at_end=shape and shape["r_g_growth"],
                         continued=more.exists(),
                         fixed_us=fixed_us, fixed_end_us=t[at], f_gro_fixed_end=f[at],
                         reaches_fixed_end=t[-1] >= fixed_us * (1 - 1e-9),

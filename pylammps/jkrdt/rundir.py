@@ -35,6 +35,7 @@ import gzip
 import zlib
 import json
 import os
+import re
 import socket
 import time
 from pathlib import Path
@@ -272,6 +273,16 @@ class RunStatus:
     error: str | None = None    # the LAMMPS error line, if any
 
 
+def settle_window(text: str) -> tuple[int, float] | None:
+    """The settle rule's window (checks) and tolerance as the run's log defined them (its
+    ``fix ... jkr/dt/settle N window K tolerance f`` line, the variables substituted);
+    None for a run without the rule."""
+    found = None
+    for m in re.finditer(r"jkr/dt/settle \d+ window (\d+) tolerance ([0-9.eE+-]+)\s", text):
+        found = (int(m.group(1)), float(m.group(2)))
+    return found
+
+
 def _settle_fields(line: str) -> dict:
     words = line.split()[1:]                 # after "jkr/dt/settle:"
     return dict(zip(words[::2], words[1::2]))
@@ -357,7 +368,7 @@ ANALYSIS_FIELDS = ("E_imp", "n_k", "E_roll", "E_break", "E_imp_over_nk_Eroll",
                    "n_fragments", "growth_efficiency", "gyration_radius_largest",
                    "contacts_per_particle", "fragment_sizes", "N_cum", "contacts_source",
                    "stop_reason", "stop_step", "last_step", "last_frame_step", "outcome_from",
-                   "settled", "problem", "time_end", "time_end_over_tc", "kinetic_start",
+                   "settled", "problem", "shape_at_end", "time_end", "time_end_over_tc", "kinetic_start",
                    "kinetic_left", "kinetic_departed", "potential_change", "energy_drift",
                    "energy_error", "energy_warning", "dissipated_fraction",
                    "dissipated_by_channel", "N_con", "N_cut", "contacts_start",
