@@ -21,12 +21,19 @@ eq. (1) at both ends where the twelve offsets are in (else what the open offsets
 average for <f_gro> < 0), and fig_fixed_end (f_gro against time, one line per run).
 Question b at 2 x 50000 writes summary.json and fig_fixed_end; any other (``--question``,
 ``--size``) writes summary_<question>_n<size>.json and fig_fixed_end_<question>_n<size>.
+Another study's settled runs are continued the same way with ``--campaigns GLOB`` (its
+campaigns below ``--protocol-runs`` and ``--protocol-records``), named by the glob:
+
+    ./run validate fixed_end --np 1 --campaigns frictional_63.1/dt_0.014 \
+        --protocol-runs validation/runs/size_trend --protocol-records \
+        validation/size_trend/records --results validation/fixed_end/size_trend
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import re
 import shutil
 import subprocess
 import sys
@@ -94,37 +101,38 @@ def keep(run: Path, record: Path) -> None:
         (record / f".{name}").rename(record / name)
 
 
-def to_continue(runs: Path, size: int, question: str, cap_tc: float,
-                twelfths=None, seeds=None) -> list[Path]:
-    """The runs of ``question`` at 2 x ``size`` that the settle rule ended before
-    ``cap_tc``, in TWELFTHS_FIRST's order (their final.restart at hand); ``twelfths``:
-    only the offsets B_off^2 = k/12 of these k; ``seeds``: only these seeds."""
+def to_continue(runs: Path, campaigns: str, cap_tc: float, twelfths=None,
+                seeds=None) -> list[Path]:
+    """The runs of the ``campaigns`` (a glob below ``runs``) that the settle rule ended
+    before ``cap_tc`` (their final.restart at hand), offsets in TWELFTHS_FIRST's order
+    (others after, by B_off); ``twelfths``: only the offsets B_off^2 = k/12 of these k;
+    ``seeds``: only these seeds."""
+    order = {round(12 * b2): k for k, b2 in enumerate(TWELFTHS_FIRST)}
     out = []
-    for b2 in TWELFTHS_FIRST:
-        if twelfths is not None and round(12 * b2) not in twelfths:
+    for run in runs.glob(f"{campaigns}/v*/b2_*/seed*"):
+        o = rundir.read_outcome(run)
+        if o is None or not (run / rundir.FINAL_RESTART).exists():
             continue
-        for run in sorted(runs.glob(f"n{size}_{question}_b2_{b2:.4f}/v*/b2_*/seed*")):
-            outcome = run / rundir.OUTCOME
-            if not (outcome.exists() and (run / rundir.FINAL_RESTART).exists()):
-                continue
-            o = json.loads(outcome.read_text())
-            if seeds is not None and o["seed"] not in seeds:
-                continue
-            if o.get("stop_reason") == "settled" and o["time_end_over_tc"] < cap_tc:
-                out.append(run)
-    return out
+        k = 12 * o["B_off"] ** 2
+        if twelfths is not None and not any(abs(k - j) < 1e-6 for j in twelfths):
+            continue
+        if seeds is not None and o["seed"] not in seeds:
+            continue
+        if o.get("stop_reason") == "settled" and o["time_end_over_tc"] < cap_tc:
+            first = order.get(round(k), len(order)) if abs(k - round(k)) < 1e-6 else len(order)
+            out.append(((first, o["B_off"], o["seed"]), run))
+    return [run for _, run in sorted(out)]
 
 
-def offsets(records: Path, kept: Path, size: int, question: str, cap_tc: float) -> list[dict]:
-    """Each paper-protocol record of ``question`` at 2 x ``size``: its f_gro(t), with the
+def offsets(records: Path, kept: Path, campaigns: str, cap_tc: float) -> list[dict]:
+    """Each record of the ``campaigns`` (a glob below ``records``): its f_gro(t), with the
     continuation's checks appended where one was kept; f_gro at its own end and at the
     fixed end ``cap_tc`` (the first check at or after it, as a cap ends a run: one capped
     later is read there too); how it ended, and how much the largest fragment's gyration
     radius grew over the settle rule's last window there (a body still being pulled apart
     by a neck, which the rule does not watch)."""
     out = []
-    for outcome in sorted(records.glob(f"n{size}_{question}_b2_*/v*/b2_*/seed*/"
-                                       f"{rundir.OUTCOME}")):
+    for outcome in sorted(records.glob(f"{campaigns}/v*/b2_*/seed*/{rundir.OUTCOME}")):
         o = json.loads(outcome.read_text())
         where = outcome.parent.relative_to(records)
         checks = from_checks(read_csv(outcome.parent / rundir.CHECKS), o["N_tar"], o["N_pro"])
@@ -139,8 +147,8 @@ def offsets(records: Path, kept: Path, size: int, question: str, cap_tc: float) 
         f = [r["growth_efficiency"] for r in checks]
         at = next((k for k, x in enumerate(t) if x >= fixed_us * (1 - 1e-9)), len(t) - 1)
         out.append(dict(record=str(where), B_off=o["B_off"], B_off2=round(o["B_off"] ** 2, 4),
-                        seed=o["seed"],
-                        stop_reason=o["stop_reason"], end_us=end_us,
+                        seed=o["seed"], model=o["model"], tvis=o["tvis"], v_col=o["v_col"],
+                        N_tar=o["N_tar"], stop_reason=o["stop_reason"], end_us=end_us,
                         f_gro_end=o["growth_efficiency"],
                         r_g_change_at_end=shape and shape["r_g_growth"],
                         continued=more.exists(),
@@ -227,6 +235,12 @@ def main(argv=None) -> int:
                    help="continue only the runs of these seeds")
     p.add_argument("--twelfths", type=int, nargs="+", default=None,
                    help="continue only the offsets B_off^2 = k/12 of these k")
+    p.add_argument("--campaigns", default=None,
+                   help="the campaigns to continue, a glob below --protocol-runs and "
+                        "--protocol-records (default n<size>_<question>_b2_*; another "
+                        "study's, e.g. --protocol-runs validation/runs/size_trend "
+                        "--protocol-records validation/size_trend/records --campaigns "
+                        "frictional_63.1/dt_0.014)")
     p.add_argument("--protocol-runs", type=Path, default=HERE / "runs" / "paper_protocol")
     p.add_argument("--protocol-records", type=Path,
                    default=HERE / "paper_protocol" / "records")
@@ -242,9 +256,10 @@ def main(argv=None) -> int:
         return 0
     runs, results = study_paths(args, "fixed_end")
     kept = results / "records"
+    campaigns = args.campaigns or f"n{args.size}_{args.question}_b2_*"
     if not args.summary_only:
-        for run in to_continue(args.protocol_runs, args.size, args.question, args.cap,
-                               args.twelfths, args.seeds):
+        for run in to_continue(args.protocol_runs, campaigns, args.cap, args.twelfths,
+                               args.seeds):
             where = run.relative_to(args.protocol_runs)
             if (kept / where / rundir.CHECKS).exists():
                 continue
@@ -259,13 +274,15 @@ def main(argv=None) -> int:
             if subprocess.run(cmd).returncode != 0:
                 raise SystemExit(f"{where}: the continuation stopped; run again to resume")
             keep(runs / where, kept / where)
-    rows = offsets(args.protocol_records, kept, args.size, args.question, args.cap)
+    rows = offsets(args.protocol_records, kept, campaigns, args.cap)
     cap_us = max((r["fixed_us"] for r in rows), default=None)
-    twelve = len(QUESTIONS[args.question]["b_off2"]) == 12    # eq. (1) over the grid
-    # the paper-size question b is the study's own; any other question or size is named
-    tag = "" if (args.question, args.size) == ("b", 50000) or args.quick else \
-        f"_{args.question}_n{args.size}"
-    done = dict(study="fixed_end", question=args.question, size=args.size,
+    # eq. (1) over the grid for a protocol question asked on the twelve offsets
+    twelve = not args.campaigns and len(QUESTIONS[args.question]["b_off2"]) == 12
+    # the paper-size question b is the study's own; any other is named
+    tag = ("_" + re.sub(r"[^A-Za-z0-9.]+", "_", args.campaigns).strip("_")
+           if args.campaigns else "" if (args.question, args.size) == ("b", 50000)
+           or args.quick else f"_{args.question}_n{args.size}")
+    done = dict(study="fixed_end", campaigns=campaigns, question=args.question, size=args.size,
                 cap_tc=args.cap, cap_us=cap_us, results=dict(
                     offsets=[{k: v for k, v in r.items() if k not in ("time_us", "f_gro")}
                              for r in rows],
@@ -274,9 +291,10 @@ def main(argv=None) -> int:
                                            "f_gro_fixed_end") if twelve else {}))
     print("\n".join(table(rows, done)))
     if rows:
-        q = QUESTIONS[args.question]
+        r = rows[0]
+        model = r["model"] + (f", T_vis {r['tvis'] * 1e12:g} ps" if r["tvis"] else "")
         done["figures"] = [p.name for p in figure(
-            rows, results, cap_us, f"{q['model']}, {q['v_col']:g} m/s, 2 x {args.size}", tag)]
+            rows, results, cap_us, f"{model}, {r['v_col']:g} m/s, 2 x {r['N_tar']}", tag)]
     return write_summary(results, done, f"summary{tag}.json")
 
 
