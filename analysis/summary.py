@@ -42,7 +42,8 @@ SCALARS = ["model", "material", "xi_crit", "tvis", "kind", "dimension", "N_tar",
            "E_imp_over_nk_Ebreak", "step", "n_total", "n_largest", "n_second", "n_fragments",
            "growth_efficiency", "gyration_radius_largest", "contacts_per_particle",
            "dissipated_fraction", "energy_error", "energy_warning", "stop_reason", "stop_step",
-           "kinetic_left", *DIAGNOSTICS, "problem", "run"]
+           "kinetic_left", "r_g_growth_at_end", "stretching_at_end", *DIAGNOSTICS, "problem",
+           "run"]
 
 
 def b_off_average(b_off2, values, grazing=None) -> np.ndarray:
@@ -192,7 +193,10 @@ def mean_diagnostics(runs) -> dict[str, float | None]:
 
 def scalars(out: dict) -> dict:
     """One run's row of runs.csv: the outcome's ``SCALARS``, its diagnostics among them."""
-    row = dict(out, **diagnostics(out), B_off2=round(out["B_off"] ** 2, 12))
+    shape = out.get("shape_at_end") or {}     # a settled run's largest body over the window
+    row = dict(out, **diagnostics(out), B_off2=round(out["B_off"] ** 2, 12),
+               r_g_growth_at_end=shape.get("r_g_growth"),
+               stretching_at_end=shape.get("stretching"))
     return {k: row.get(k, "steps" if k == "stop_reason" else None) for k in SCALARS}
 
 
@@ -275,7 +279,12 @@ def summarise(campaign, plot: bool = True, include_cap: bool = False) -> dict:
     write_csv(campaign / "summary.csv", table)
     by_offset = offset_table(groups)
     write_csv(campaign / "f_gro_by_offset.csv", offset_rows(by_offset))
-    summary = dict(runs=len(outcomes), left_out=left_out, include_cap=include_cap, table=table,
+    # settled while a neck still stretched their largest body: counted, but flagged
+    stretching = [dict(run=o["run"], growth_efficiency=o["growth_efficiency"],
+                       r_g_growth=o["shape_at_end"]["r_g_growth"]) for o in outcomes
+                  if (o.get("shape_at_end") or {}).get("stretching")]
+    summary = dict(runs=len(outcomes), left_out=left_out, stretching_at_end=stretching,
+                   include_cap=include_cap, table=table,
                    v_fra=thresholds, v_fra_per_seed=seed_thresholds,
                    f_gro_by_offset=by_offset)
     if plot:

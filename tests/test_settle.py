@@ -235,3 +235,10 @@ def test_a_frictionless_hinge_opening_counts_as_settled_and_the_outcome_says_so(
     assert shape["r_g_growth"] == pytest.approx(r_g[-1] / r_g[0] - 1, rel=1e-12)
     assert shape["r_g_growth"] > RULE.tolerance and shape["stretching"] is True
     assert "a neck may still part it" in summary_text(out)
+    summary = summarise(tmp_path, plot=False)            # a campaign's summary flags it
+    assert summary["runs"] == 1 and summary["stretching_at_end"] == [dict(
+        run=str(run), growth_efficiency=out["growth_efficiency"],
+        r_g_growth=shape["r_g_growth"])]
+    row, = read_csv(tmp_path / "runs.csv")
+    assert row["stretching_at_end"] == "True"
+    assert row["r_g_growth_at_end"] == pytest.approx(shape["r_g_growth"], rel=1e-12)

@@ -527,6 +527,10 @@ def summarise(args) -> int:
     for gone in summary["left_out"]:
         print(f"left out ({gone['stop_reason']}): {gone['run']}"
               + (f": {gone['problem']}" if gone.get("problem") else ""))
+    for body in summary["stretching_at_end"]:
+        print(f"settled while its largest body still stretched (r_g "
+              f"{100 * body['r_g_growth']:+.1f} % over the settle window; f_gro "
+              f"{body['growth_efficiency']:+.3f} may yet fall): {body['run']}")
     for model, v in summary["v_fra"].items():
         print(f"v_fra ({model}): " + (f"{v:.3g} m/s" if v else "no crossing of <f_gro> = 0"))
     for p in summary.get("pictures", []):
