@@ -28,8 +28,7 @@ import sys
 from pathlib import Path
 
 from jkrdt import rundir
-from jkrdt.analysis.outcome import from_checks
-from jkrdt.analysis.outcome import stretching as stretching_at
+from jkrdt.analysis.outcome import from_checks, stretching as stretching_at
 from jkrdt.analysis.tables import read_csv
 from jkrdt.stopping import SettleRule
 from paper_protocol import PAPER_CAP_TC
