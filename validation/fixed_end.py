@@ -225,6 +225,16 @@ def table(rows: list[dict], done: dict) -> list[str]:
     return lines
 
 
+def results_tag(args) -> str:
+    """What names the summary and figure: nothing for the study's own question (b at
+    2 x 50000) and its quick variant, else the question and size, or the campaigns' glob."""
+    if args.campaigns:
+        return "_" + re.sub(r"[^A-Za-z0-9.]+", "_", args.campaigns).strip("_")
+    if args.quick or (args.question, args.size) == ("b", 50000):
+        return ""
+    return f"_{args.question}_n{args.size}"
+
+
 def main(argv=None) -> int:
     p = campaign_study_parser(__doc__)
     p.add_argument("--question", default=None, help="default b (--quick: a)")
@@ -278,10 +288,7 @@ def main(argv=None) -> int:
     cap_us = max((r["fixed_us"] for r in rows), default=None)
     # eq. (1) over the grid for a protocol question asked on the twelve offsets
     twelve = not args.campaigns and len(QUESTIONS[args.question]["b_off2"]) == 12
-    # the paper-size question b is the study's own; any other is named
-    tag = ("_" + re.sub(r"[^A-Za-z0-9.]+", "_", args.campaigns).strip("_")
-           if args.campaigns else "" if (args.question, args.size) == ("b", 50000)
-           or args.quick else f"_{args.question}_n{args.size}")
+    tag = results_tag(args)
     done = dict(study="fixed_end", campaigns=campaigns, question=args.question, size=args.size,
                 cap_tc=args.cap, cap_us=cap_us, results=dict(
                     offsets=[{k: v for k, v in r.items() if k not in ("time_us", "f_gro")}

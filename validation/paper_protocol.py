@@ -55,6 +55,7 @@ import numpy as np
 from bpca3d_models import MODELS, model_spec
 from common import campaign_study_parser, run_campaigns, save, study_paths, write_summary
 from jkrdt import protocol, rundir
+from jkrdt.analysis.outcome import from_checks
 from jkrdt.analysis.summary import (b_off_average, b_off_groups, mean_diagnostics, scalars,
                                    seed_scatter)
 from jkrdt.analysis.tables import read_csv, write_csv
@@ -140,20 +141,20 @@ SNAPSHOTS_US = (0.4, 0.8, 1.2, 1.6)
 def f_gro_at(record: Path, n_tar: int, n_pro: int) -> dict[str, float | None]:
     """f_gro = (N_lar - N_tar) / N_pro at SNAPSHOTS_US from the run's settle checks (the
     last check at or before each time; the settled value after the run's end)."""
-    rows = read_csv(record / rundir.CHECKS)
+    rows = from_checks(read_csv(record / rundir.CHECKS), n_tar, n_pro)
     out = {}
     for t in SNAPSHOTS_US:
         before = [r for r in rows if r["time"] <= t * 1e-6 * (1 + 1e-9)]
-        out[f"{t:g}"] = (before[-1]["n_largest"] - n_tar) / n_pro if before else None
+        out[f"{t:g}"] = before[-1]["growth_efficiency"] if before else None
     return out
 
 
 def f_gro_range_before_end(record: Path, n_tar: int, n_pro: int) -> list[float]:
     """[min, max] of f_gro over the run's settle checks in its last CAP_SPAN_US: for a run
     counted at its cap, how far its outcome still moved."""
-    rows = read_csv(record / rundir.CHECKS)
+    rows = from_checks(read_csv(record / rundir.CHECKS), n_tar, n_pro)
     since = rows[-1]["time"] - CAP_SPAN_US * 1e-6
-    f = [(r["n_largest"] - n_tar) / n_pro for r in rows if r["time"] >= since]
+    f = [r["growth_efficiency"] for r in rows if r["time"] >= since]
     return [min(f), max(f)]
 
 

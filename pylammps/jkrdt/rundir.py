@@ -369,8 +369,8 @@ ANALYSIS_FIELDS = ("E_imp", "n_k", "E_roll", "E_break", "E_imp_over_nk_Eroll",
                    "contacts_per_particle", "fragment_sizes", "N_cum", "contacts_source",
                    "stop_reason", "stop_step", "last_step", "last_frame_step", "outcome_from",
                    "settled", "problem", "shape_at_end", "time_end", "time_end_over_tc",
-                   "kinetic_start", "kinetic_left", "kinetic_departed", "potential_change", "energy_drift",
-                   "energy_error", "energy_warning", "dissipated_fraction",
+                   "kinetic_start", "kinetic_left", "kinetic_departed", "potential_change",
+                   "energy_drift", "energy_error", "energy_warning", "dissipated_fraction",
                    "dissipated_by_channel", "N_con", "N_cut", "contacts_start",
                    "contacts_end", "pictures", "diagnostics")
 OUTCOME_FIELDS = PARAMETER_FIELDS + ANALYSIS_FIELDS
