@@ -99,8 +99,9 @@ def run_campaigns(specs: dict[str, dict], runs: Path, ranks: int,
                   ranks_per_run: int = 1) -> dict[str, Path]:
     """Run one ``jkrdt campaign`` per spec (``runs/<name>``), each over ``ranks`` MPI ranks
     in groups of ``ranks_per_run`` (each group runs whole collisions); a second call resumes
-    them. As each campaign ends its finished runs' small records are kept (``records_of``,
-    ``keep_records``). Returns the campaign directories."""
+    them. As each campaign ends, or stops (a signal, a lost rank), its finished runs' small
+    records are kept (``records_of``, ``keep_records``), so that a run that finished is kept
+    however its campaign ended. Returns the campaign directories."""
     runs.mkdir(parents=True, exist_ok=True)
     where = campaign_paths(specs, runs)
     for name, spec in specs.items():
@@ -111,24 +112,50 @@ def run_campaigns(specs: dict[str, dict], runs: Path, ranks: int,
             cmd = [str(BIN / "mpirun"), "-np", str(ranks)] + cmd + \
                 ["--ranks-per-run", str(min(ranks_per_run, ranks))]
         t0 = time.time()
-        done = subprocess.run(cmd)
-        if done.returncode not in (0, 1):        # 1: some runs failed, recorded as such
-            raise SystemExit(f"{name}: jkrdt campaign stopped (exit status {done.returncode})")
+        returncode = wait_keeping_records(subprocess.Popen(cmd), where[name])
+        if returncode not in (0, 1):             # 1: some runs failed, recorded as such
+            raise SystemExit(f"{name}: jkrdt campaign stopped (exit status {returncode}); "
+                             "its finished runs' records are kept, run again to resume")
         print(f"{name}: campaign done in {time.time() - t0:.0f} s"
-              + (" (some runs failed: see their outcome.json)" if done.returncode else ""),
+              + (" (some runs failed: see their outcome.json)" if returncode else ""),
               flush=True)
-        records = records_of(where[name])
-        if records is not None:
-            keep_records(where[name], records)
     return where
+
+
+#: how often (s) a running campaign's newly finished runs have their records kept
+KEEP_EVERY = 30.0
+
+
+def wait_keeping_records(campaign, where: Path) -> int:
+    """Wait for the ``campaign`` process (running in ``where``), keeping each of its runs'
+    small records as soon as the run finishes, not only when the whole campaign does, and
+    once more as it ends, however it ends: on Ctrl-C here the campaign is stopped too (it
+    resumes later) and what it finished is kept. Returns its exit status."""
+    import signal
+
+    records = records_of(where)
+    try:
+        while True:
+            try:
+                return campaign.wait(timeout=KEEP_EVERY)
+            except subprocess.TimeoutExpired:
+                if records is not None:
+                    keep_records(where, records)
+    except BaseException:
+        campaign.send_signal(signal.SIGINT)
+        campaign.wait()
+        raise
+    finally:
+        if records is not None:
+            keep_records(where, records)
 
 
 def keep_records(campaign: Path, records: Path) -> list[Path]:
     """Copy the small record (``jkrdt.rundir.RECORD``) of every finished run below
-    ``campaign`` to the same place below ``records``, so that the study re-analyses and
-    re-plots from the repository alone once its run directories are gone. A record is
-    copied whole or not at all (its outcome.json last) and never replaced; returns the
-    records it copied."""
+    ``campaign`` (``rundir.finished``: not the partial outcome of a run cut off) to the same
+    place below ``records``, so that the study re-analyses and re-plots from the repository
+    alone once its run directories are gone. A record is copied whole or not at all (its
+    outcome.json last) and never replaced; returns the records it copied."""
     import shutil
 
     from jkrdt import rundir
@@ -137,7 +164,7 @@ def keep_records(campaign: Path, records: Path) -> list[Path]:
     for outcome in sorted(Path(campaign).rglob(rundir.OUTCOME)):
         run = outcome.parent
         to = records / run.relative_to(campaign)
-        if (to / rundir.OUTCOME).exists():
+        if (to / rundir.OUTCOME).exists() or not rundir.finished(run):
             continue
         to.mkdir(parents=True, exist_ok=True)
         for name in rundir.RECORD:
