@@ -625,3 +625,112 @@ def test_the_fixed_end_study_continues_settled_runs_as_the_same_collision(tmp_pa
         assert 1200 * t_c <= more[-1]["time"] < 1200 * t_c + every * meta["dt_over_tc"] * t_c
         assert r["fixed_end_us"] == pytest.approx(more[-1]["time"] * 1e6, rel=1e-12)
         assert r["f_gro_fixed_end"] == (more[-1]["n_largest"] - 24) / 24
+
+
+def test_a_stopped_campaign_keeps_the_records_of_the_runs_it_finished(tmp_path):
+    # validation/common.py run_campaigns: two 2 x 64 collisions at 20 m/s, one after the
+    # other, stopped by SIGINT while the second runs. The first run's small record is kept
+    # as it is (outcome.json to the digit), the second's is not: a campaign cut off by a
+    # lost machine or a signal leaves the runs it finished in the repository. A partial
+    # analysis of the cut-off run ("cut off") is no record either, and the resumed
+    # campaign keeps the second run's record when it ends.
+    import os
+    import signal
+    import time
+
+    from jkrdt import rundir
+
+    spec = dict(kind="bpca", dim=3, n_tar=64, n_pro=64, material="ice", model="frictional",
+                v_col=[20.0], b_off2=[0.25], seeds=[1, 2], settle=dict(check_tc=5))
+    runs, records = tmp_path / "runs", tmp_path / "records"
+    driver = ("import json, sys; sys.path.insert(0, sys.argv[1]); "
+              "from pathlib import Path; from common import RECORDS_OF, run_campaigns; "
+              "RECORDS_OF[Path(sys.argv[2]).resolve()] = Path(sys.argv[3]); "
+              "run_campaigns({'c': json.loads(sys.argv[4])}, Path(sys.argv[2]), 1)")
+    cmd = [sys.executable, "-c", driver, str(ROOT / "validation"), str(runs), str(records),
+           json.dumps(spec)]
+    proc = subprocess.Popen(cmd, start_new_session=True, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    deadline = time.time() + 300
+    while time.time() < deadline:
+        done = sorted(runs.rglob("outcome.json"))
+        going = [p.parent for p in runs.rglob("restart.a") if not (p.parent / "outcome.json")
+                 .exists()]
+        if len(done) == 1 and going:
+            break
+        time.sleep(0.02)
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode != 0 and "KeyboardInterrupt" in err, err
+    [first] = done
+    [cut] = going
+    kept = sorted(records.rglob("outcome.json"))
+    assert [p.relative_to(records) for p in kept] == [first.relative_to(runs)]
+    assert json.loads(kept[0].read_text()) == json.loads(first.read_text())
+    assert not (records / cut.relative_to(runs)).exists()
+    subprocess.run([str(Path(sys.executable).parent / "jkrdt"), "analyse", str(cut), "--partial",
+                    "--no-plots"], check=True, capture_output=True, timeout=300)
+    assert rundir.read_outcome(cut)["stop_reason"] == "cut off"
+    sys.path.insert(0, str(ROOT / "validation"))
+    try:
+        from common import keep_records
+    finally:
+        sys.path.pop(0)
+    assert keep_records(runs / "c", records / "c") == []
+    subprocess.run(cmd, check=True, capture_output=True, timeout=300)
+    kept = sorted(records.rglob("outcome.json"))
+    assert len(kept) == 2
+    assert json.loads((records / cut.relative_to(runs) / "outcome.json").read_text()) == \
+        json.loads((cut / "outcome.json").read_text())
+
+
+def test_the_papers_other_statements_are_asked_of_each_model_on_the_same_scenes(tmp_path):
+    # validation/paper_protocol.py --quick, questions a, e and f: the runs that the paper's
+    # statements of App. C bear on, 2 x 24 ice BPCAs. e: the other three models head-on at
+    # 100 m/s (seeds 1, 2); f: all four models at 10 m/s on four offsets (seed 1). Each
+    # model's energy goes only where its model lets it: the undamped models dissipate
+    # nothing by damping and the frictionless ones nothing by sliding, rolling or
+    # twisting, so that E_dis,tot = E_dis,c exactly for the undamped frictionless model;
+    # the statements compare the models scene by scene (the same speed, offset and seed)
+    results = run_quick("paper_protocol", tmp_path, "--questions", "a", "e", "f")
+    runs = read_csv(results / "runs.csv")
+    models = {r["model_name"] for r in runs}
+    assert len(runs) == 2 + 6 + 16 and len(models) == 4
+    for r in runs:
+        tangential = r["E_dis_sliding"] + r["E_dis_rolling"] + r["E_dis_twisting"]
+        assert r["E_dis_tot"] == pytest.approx(r["E_dis_c"] + r["E_dis_v"] + tangential,
+                                               rel=1e-9, abs=1e-15)
+        if "T_vis" not in r["model_name"]:
+            assert r["E_dis_v"] == 0.0
+        if r["model_name"].startswith("frictionless"):
+            assert tangential == 0.0
+        if r["model_name"] == "frictionless":
+            assert r["E_dis_c"] == r["E_dis_tot"]
+    summary = json.loads((results / "summary.json").read_text())
+    assert sorted(summary["results"]["by_question"]["f"]) == sorted(
+        f"24, {m}" for m in models)
+    rows = {s["paper"].split(" (")[0]: s for s in summary["results"]["statements"]}
+    # the damped frictionless model's own row: its runs at 100 m/s (e) and 10 m/s (f), the
+    # grazing misses left out (nothing dissipated, nothing made)
+    collided = [r for r in runs if r["E_dis_tot"] > 1e-9]
+    damped_less = [r for r in collided if r["model_name"] == "frictionless, T_vis 6 ps"]
+    row = rows["frictionless, damped: N_con > N_tot for 10 <= v_col <= 100 m/s"]
+    assert row["runs"] == len(damped_less) and row["size"] == "2 x 24"
+    assert row["holds"] == all(r["N_con"] > r["n_total"] for r in damped_less)
+    # frictionless against frictional on the same scene: at 10 m/s each of two models
+    # against each of two on the offsets where both collided; at 100 m/s head-on, seed by
+    # seed, the undamped (a) and damped (e) frictionless against both frictional models (e)
+    slow = [r for r in collided if r["v_col"] == 10.0]
+    scene = lambda r: (r["v_col"], r["B_off"], r["seed"])    # noqa: E731
+    pairs = [(a, b) for a in collided for b in collided if scene(a) == scene(b)
+             and a["model_name"].startswith("frictionless")
+             and not b["model_name"].startswith("frictionless")]
+    row = rows["E_dis,c of the frictionless models above that of the frictional models for "
+               "10 <= v_col <= 100 m/s"]
+    assert row["runs"] == len(pairs) == 2 * 2 * 2 + 4 * len({r["B_off"] for r in slow})
+    assert row["holds"] == all(a["E_dis_c"] > b["E_dis_c"] for a, b in pairs)
+    row = rows["frictional models at about 10 m/s: N_con < N_tot"]
+    frictional_slow = [r for r in slow if not r["model_name"].startswith("frictionless")]
+    assert row["runs"] == len(frictional_slow)
+    assert row["holds"] == all(r["N_con"] < r["n_total"] for r in frictional_slow)
+    assert "fig_statements.png" in summary["figures"]

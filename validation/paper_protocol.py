@@ -13,6 +13,14 @@ no collision), with its diagnostics (N_con, N_cut, E_dis by channel, N_cum: ever
   b   frictionless, undamped, 39.8 m/s, on the paper's twelve offsets: <f_gro> should be
       clearly negative (v_fra 30 m/s); four offsets gave +0.06 at 2 x 50000
   d   frictionless, undamped, 31.6 m/s, the paper's twelve offsets: the next speed down
+  e   the frictional, damped frictional and damped frictionless models, head-on, 100 m/s:
+      f_gro about 1 with E_dis,tot about E_imp (App. C.1), one campaign per model
+  f   all four models at 10 m/s on four offsets (seed 1): N_con < N_tot for the frictional
+      models, N_cut well below N_tot for all but the undamped frictionless (App. C.2)
+
+e and f are there for the paper's statements (``statements``: every statement of App. C
+that gives a number or a sign, one row each, read at each speed at the largest size that
+ran it, the models compared on the same scenes), drawn in fig_statements.
 
 Each question is placed first at 2 x 5000 with seeds 1 and 2 (``--stage place``, about
 ten times cheaper, two collisions side by side on the two ranks), then asked at the
@@ -67,7 +75,10 @@ from vfra_size import TOLERANCE
 #: of the four of the other studies, then the rest, and 9/12 last: at 2 x 50000 its outcome
 #: was fixed from 0.5 us on (f_gro -0.04 to -0.03) while it ran on toward its cap
 TWELFTHS_FIRST = [protocol.B_OFF2[k] for k in (1, 2, 0, 3, 6, 4, 5, 7, 8, 10, 11, 9)]
-#: the questions, in the order they run: the model, its speed, the offsets, what the paper says
+#: the questions, in the order they run: the model (or models, a campaign each), its speed,
+#: the offsets, what the paper says; the seeds where a question sets its own at the
+#: placement. e and f are the runs that the paper's other statements of App. C bear on
+#: (``statements``): the other three models head-on at 100 m/s, all four at 10 m/s
 QUESTIONS = {
     "a": dict(model="frictionless", v_col=100.0, b_off2=[0.0],
               paper="f_gro about -1, E_dis,tot well below E_imp (App. C.1, Fig. B.1c)"),
@@ -77,7 +88,25 @@ QUESTIONS = {
               paper="<f_gro> below 0 above v_fra = 30 m/s (Fig. 2)"),
     "d": dict(model="frictionless", v_col=31.6, b_off2=TWELFTHS_FIRST,
               paper="<f_gro> about 0 at v_fra = 30 m/s (Fig. 2)"),
+    "e": dict(model=("frictional", "frictional, T_vis 6 ps", "frictionless, T_vis 6 ps"),
+              v_col=100.0, b_off2=[0.0],
+              paper="f_gro about 1 with E_dis,tot about E_imp (App. C.1, Figs. C.1a, b, d)"),
+    "f": dict(model=tuple(MODELS), v_col=10.0, b_off2=[0.0, 0.25, 0.5, 0.75], seeds=[1],
+              paper="frictional: N_con < N_tot; all but the undamped frictionless: N_cut "
+                    "well below N_tot (App. C.2, Figs. C.3, C.4)"),
 }
+
+
+def models_of(question: str) -> tuple[str, ...]:
+    """The models (``bpca3d_models.MODELS`` names) a question asks, one or several."""
+    model = QUESTIONS[question]["model"]
+    return (model,) if isinstance(model, str) else tuple(model)
+
+
+def model_name(outcome: dict) -> str:
+    """The MODELS name of a run's model, from its outcome (its kind and T_vis)."""
+    return next(name for name, (kind, tvis, _) in MODELS.items()
+                if kind == outcome["model"] and tvis == (outcome.get("tvis") or 0.0))
 #: the paper stage's cap, t_c (4.4 us for 0.1 um ice): a run that has not settled by then
 #: ends there and is counted at its end, as the paper's runs end at a time it does not
 #: state. Twice the latest any paper-size run settled (8302 t_c, b at 6/12) and 2.7 times
@@ -101,22 +130,24 @@ QUICK = dict(n=24, seeds=[1, 2], ranks_per_run=1, one_campaign=True)
 
 
 def campaign_specs(question: str, stage: dict) -> dict[str, dict]:
-    """The campaigns of one question at one stage: one per offset (or one in all), each
-    with all its seeds."""
+    """The campaigns of one question at one stage: one per model and offset (or one per
+    model in all), each with all its seeds."""
     q = QUESTIONS[question]
-    seeds = stage.get("more_seeds", {}).get(question, stage["seeds"])
+    seeds = stage.get("more_seeds", {}).get(question, q.get("seeds", stage["seeds"]))
     groups = [q["b_off2"]] if stage.get("one_campaign") else [[b2] for b2 in q["b_off2"]]
     kept = stage.get("default_cap", {}).get(question, ())
+    models = models_of(question)
 
     def settle(b2):    # the stage's cap, unless the campaign began with the default one
         if "cap_tc" not in stage or any(abs(b2[0] - k) < 1e-9 for k in kept):
             return {}
         return dict(settle=dict(cap_tc=stage["cap_tc"]))
 
-    return {f"n{stage['n']}/{question}/b2_{b2[0]:.4f}" + ("_all" if len(b2) > 1 else ""):
-            model_spec(q["model"], stage["n"], v_col=[q["v_col"]], b_off2=b2, seeds=seeds,
+    return {f"n{stage['n']}/{question}/b2_{b2[0]:.4f}" + ("_all" if len(b2) > 1 else "")
+            + (f"/{model}" if len(models) > 1 else ""):
+            model_spec(model, stage["n"], v_col=[q["v_col"]], b_off2=b2, seeds=seeds,
                        dt="auto", tolerance=TOLERANCE, **settle(b2))
-            for b2 in groups}
+            for model in models for b2 in groups}
 
 
 def run_question(question: str, stage: dict, runs: Path, ranks: int) -> None:
@@ -202,7 +233,8 @@ def question_summary(runs: list[dict], twelve: bool) -> dict:
 
     _, con = b_off_groups(runs, per_grain("N_con"))
     _, cut = b_off_groups(runs, per_grain("N_cut"))
-    out = dict(runs=len(runs), B_off2=[float(b) for b in b2], f_gro=[float(x) for x in f],
+    out = dict(runs=len(runs), N_tar=runs[0]["N_tar"], model=model_name(runs[0]),
+               B_off2=[float(b) for b in b2], f_gro=[float(x) for x in f],
                f_gro_per_seed=dict(per_seed), N_con_over_N_tot=[float(x) for x in con],
                N_cut_over_N_tot=[float(x) for x in cut],
                paper_grid=protocol.is_paper_grid(b2))
@@ -221,39 +253,80 @@ def question_summary(runs: list[dict], twelve: bool) -> dict:
     return out
 
 
+#: the questions whose runs are there for the paper's statements (``statements``), drawn in
+#: ``statements_figure`` rather than as offsets in fig_protocol
+STATEMENT_QUESTIONS = ("e", "f")
+#: the frictional and the frictionless models (MODELS names)
+FRICTIONAL = ("frictional", "frictional, T_vis 6 ps")
+FRICTIONLESS = ("frictionless", "frictionless, T_vis 6 ps")
+
+
+def pick(rows: list[dict], model=None, v=None, b2=None) -> list[dict]:
+    """The runs of ``model`` (a MODELS name or several) at ``v`` and ``b2`` (None: any), at
+    each speed those of the largest size that ran it."""
+    models = (model,) if isinstance(model, str) else model
+    sel = [r for r in rows if (model is None or r["model_name"] in models)
+           and (v is None or abs(r["v_col"] - v) < 0.05)
+           and (b2 is None or abs(r["B_off"] ** 2 - b2) < 1e-6)]
+    top = defaultdict(int)
+    for r in sel:
+        top[r["v_col"]] = max(top[r["v_col"]], r["N_tar"])
+    return [r for r in sel if r["N_tar"] == top[r["v_col"]]]
+
+
+def collided(run: dict) -> bool:
+    """Whether the aggregates touched (a grazing offset can miss: nothing dissipated but
+    rounding)."""
+    return run["E_dis_tot"] > 1e-9
+
+
+def same_scenes(rows: list[dict], v=None) -> list[tuple[dict, dict]]:
+    """(frictionless run, frictional run) pairs of one scene (speed, offset, seed, size),
+    each frictionless model against each frictional one."""
+    scene = lambda r: (r["v_col"], round(r["B_off"], 6), r["seed"], r["N_tar"])  # noqa: E731
+    less = [r for r in pick(rows, FRICTIONLESS, v) if collided(r)]
+    more = defaultdict(list)
+    for r in rows:
+        if r["model_name"] in FRICTIONAL and (v is None or abs(r["v_col"] - v) < 0.05) \
+                and collided(r):
+            more[scene(r)].append(r)
+    return [(a, b) for a in less for b in more[scene(a)]]
+
+
 def statements(rows: list[dict]) -> list[dict]:
     """The paper's statements of App. C and Sect. 3 that give a number or a sign, each
-    against the runs that bear on it (the largest size that has them)."""
-    def pick(model=None, v=None, b2=None):
-        models = (model,) if isinstance(model, str) else model
-        sel = [r for r in rows if (model is None or r["model_name"] in models)
-               and (v is None or abs(r["v_col"] - v) < 0.05)
-               and (b2 is None or abs(r["B_off"] ** 2 - b2) < 1e-6)]
-        top = max((r["N_tar"] for r in sel), default=None)
-        return [r for r in sel if r["N_tar"] == top]
-
+    against the runs that bear on it (at each speed, the largest size that has them)."""
     def row(paper, runs, measured, holds):
+        sizes = sorted({r["N_tar"] for r in runs}, reverse=True)
         return dict(paper=paper, runs=len(runs),
-                    size=f"2 x {runs[0]['N_tar']}" if runs else None,
+                    size=", ".join(f"2 x {n}" for n in sizes) if runs else None,
                     measured=measured if runs else "not run", holds=holds if runs else None)
 
+    def per_grain(runs, name):
+        x = [r[name] / r["n_total"] for r in runs]
+        return f"{name} / N_tot {min(x):.2f} to {max(x):.2f}" if runs else None
+
+    def speeds(runs):
+        return " at " + ", ".join(f"{v:g}" for v in sorted({r["v_col"] for r in runs})) + \
+            " m/s" if runs else ""
+
     out = []
-    fl = [r for r in pick("frictionless") if r["E_dis_tot"]]    # not a grazing miss
-    out.append(row("frictionless, undamped: N_con > N_tot for 10 <= v_col <= 100 m/s "
-                   "(App. C.2, Fig. C.3c)", fl,
-                   f"N_con / N_tot {min(r['N_con'] / r['n_total'] for r in fl):.2f} to "
-                   f"{max(r['N_con'] / r['n_total'] for r in fl):.2f}" if fl else None,
-                   all(r["N_con"] > r["n_total"] for r in fl)))
+    for name, fig in (("frictionless", "c"), ("frictionless, T_vis 6 ps", "d")):
+        fl = [r for r in pick(rows, name) if collided(r)]
+        what = "undamped" if name == "frictionless" else "damped"
+        out.append(row(f"frictionless, {what}: N_con > N_tot for 10 <= v_col <= 100 m/s "
+                       f"(App. C.2, Fig. C.3{fig})", fl,
+                       (per_grain(fl, "N_con") or "") + speeds(fl),
+                       all(r["N_con"] > r["n_total"] for r in fl)))
+    fl = [r for r in pick(rows, "frictionless") if collided(r)]
     out.append(row("frictionless, undamped: N_cut > N_tot for 10 <= v_col <= 100 m/s "
-                   "(App. C.2, Fig. C.4c)", fl,
-                   f"N_cut / N_tot {min(r['N_cut'] / r['n_total'] for r in fl):.2f} to "
-                   f"{max(r['N_cut'] / r['n_total'] for r in fl):.2f}" if fl else None,
+                   "(App. C.2, Fig. C.4c)", fl, (per_grain(fl, "N_cut") or "") + speeds(fl),
                    all(r["N_cut"] > r["n_total"] for r in fl)))
     out.append(row("frictionless, undamped: E_dis,c = E_dis,tot (App. C.1, Fig. C.2c)", fl,
                    f"E_dis,c / E_dis,tot {min(r['E_dis_c'] / r['E_dis_tot'] for r in fl):.4f}"
                    if fl else None,
                    all(abs(r["E_dis_c"] / r["E_dis_tot"] - 1) < 1e-9 for r in fl)))
-    a = pick("frictionless", 100.0, 0.0)
+    a = pick(rows, "frictionless", 100.0, 0.0)
     out.append(row("frictionless, undamped, head-on, 100 m/s: f_gro about -1 (App. C.1, "
                    "Fig. B.1c)", a,
                    ", ".join(f"{r['growth_efficiency']:+.3f}" for r in a),
@@ -262,29 +335,98 @@ def statements(rows: list[dict]) -> list[dict]:
                    "E_imp (App. C.1, Fig. C.1c)", a,
                    "E_dis,tot / E_imp " + ", ".join(f"{r['E_dis_tot']:.3f}" for r in a),
                    all(r["E_dis_tot"] < 0.5 for r in a)))
-    fr = [r for r in pick("frictional, T_vis 6 ps") if r["E_dis_tot"]]
-    out.append(row("frictional models: E_dis,c / E_dis,tot << 1 (App. C.1)", fr,
-                   "E_dis,c / E_dis,tot " + ", ".join(f"{r['E_dis_c'] / r['E_dis_tot']:.3f}"
-                                                       for r in fr),
-                   all(r["E_dis_c"] / r["E_dis_tot"] < 0.1 for r in fr)))
-    # what no question here runs yet, listed so that the table is the paper's whole list
-    others = ("frictional", "frictional, T_vis 6 ps", "frictionless, T_vis 6 ps")
-    h = pick(others, 100.0, 0.0)
+    h = pick(rows, FRICTIONAL + FRICTIONLESS[1:], 100.0, 0.0)
     out.append(row("frictional, damped frictional and damped frictionless, head-on, 100 m/s: "
                    "f_gro about 1 with E_dis,tot about E_imp (App. C.1)", h,
-                   ", ".join(f"{r['model_name']}: f_gro {r['growth_efficiency']:+.3f}, "
-                             f"E_dis,tot {r['E_dis_tot']:.3f}" for r in h),
+                   "; ".join(f"{r['model_name']} (seed {r['seed']}): f_gro "
+                             f"{r['growth_efficiency']:+.3f}, E_dis,tot {r['E_dis_tot']:.3f}"
+                             for r in h),
                    all(r["growth_efficiency"] > 0.5 and r["E_dis_tot"] > 0.8 for r in h)))
-    slow = pick(others[:2], 10.0)
+    fr = [r for r in pick(rows, FRICTIONAL) if collided(r)]
+    out.append(row("frictional models: E_dis,c / E_dis,tot << 1 (App. C.1)", fr,
+                   (f"E_dis,c / E_dis,tot {min(r['E_dis_c'] / r['E_dis_tot'] for r in fr):.3f}"
+                    f" to {max(r['E_dis_c'] / r['E_dis_tot'] for r in fr):.3f}" + speeds(fr))
+                   if fr else None,
+                   all(r["E_dis_c"] / r["E_dis_tot"] < 0.1 for r in fr)))
+    pairs = same_scenes(rows)
+    out.append(row("E_dis,c of the frictionless models above that of the frictional models "
+                   "for 10 <= v_col <= 100 m/s (App. C.1, Fig. C.2)", [a for a, _ in pairs],
+                   f"frictionless less frictional E_dis,c on the same scene "
+                   f"{min(a['E_dis_c'] - b['E_dis_c'] for a, b in pairs):+.3f} E_imp at "
+                   f"least, {len(pairs)} pairs" + speeds([a for a, _ in pairs])
+                   if pairs else None,
+                   all(a["E_dis_c"] > b["E_dis_c"] for a, b in pairs)))
+    pairs = same_scenes(rows, 10.0)
+    out.append(row("at about 10 m/s, E_dis,tot of the frictionless models above that of the "
+                   "frictional models (App. C.1, Fig. C.1)", [a for a, _ in pairs],
+                   f"frictionless less frictional E_dis,tot on the same scene "
+                   f"{min(a['E_dis_tot'] - b['E_dis_tot'] for a, b in pairs):+.3f} to "
+                   f"{max(a['E_dis_tot'] - b['E_dis_tot'] for a, b in pairs):+.3f} E_imp, "
+                   f"{len(pairs)} pairs" if pairs else None,
+                   all(a["E_dis_tot"] > b["E_dis_tot"] for a, b in pairs)))
+    slow = [r for r in pick(rows, FRICTIONAL, 10.0) if collided(r)]
     out.append(row("frictional models at about 10 m/s: N_con < N_tot (App. C.2, Figs. C.3a, "
-                   "b)", slow, ", ".join(f"{r['N_con'] / r['n_total']:.2f}" for r in slow),
+                   "b)", slow, per_grain(slow, "N_con"),
                    all(r["N_con"] < r["n_total"] for r in slow)))
-    slow = pick(others, 10.0)
+    slow = [r for r in pick(rows, FRICTIONAL + FRICTIONLESS[1:], 10.0) if collided(r)]
     out.append(row("all but the undamped frictionless model at about 10 m/s: N_cut "
-                   "significantly below N_tot (App. C.2)", slow,
-                   ", ".join(f"{r['N_cut'] / r['n_total']:.2f}" for r in slow),
+                   "significantly below N_tot (App. C.2, Figs. C.4a, b, d)", slow,
+                   per_grain(slow, "N_cut"),
                    all(r["N_cut"] < 0.5 * r["n_total"] for r in slow)))
     return out
+
+
+def statements_figure(rows: list[dict], results: Path) -> list[Path]:
+    """The runs of the paper's statements as its Figs. C.1-C.4 show them: at 10 m/s, N_con
+    and N_cut over N_tot against B_off^2, each model; head-on at 100 m/s, f_gro and
+    E_dis,tot / E_imp of each model (the four, at the size all of them ran)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (left, right) = plt.subplots(1, 2, figsize=(10.5, 4.2))
+    colors = {name: f"C{j}" for j, name in enumerate(MODELS)}
+    slow = pick(rows, None, 10.0)
+    for name in MODELS:
+        runs = sorted((r for r in slow if r["model_name"] == name and collided(r)),
+                      key=lambda r: r["B_off"])
+        if not runs:
+            continue
+        b2 = [r["B_off"] ** 2 for r in runs]
+        left.plot(b2, [r["N_con"] / r["n_total"] for r in runs], "o-", color=colors[name],
+                  label=f"{name}: N_con")
+        left.plot(b2, [r["N_cut"] / r["n_total"] for r in runs], "s--", color=colors[name],
+                  mfc="none", label=f"{name}: N_cut")
+    left.axhline(1, color="0.5", lw=0.8)
+    left.text(0.0, 1.0, " N_tot", fontsize=7, va="bottom", color="0.4")
+    left.set_yscale("symlog", linthresh=0.1)      # a collision that cut nothing shows
+    left.set_xlabel("B_off^2")
+    left.set_ylabel("contacts made (N_con), cut (N_cut) / N_tot")
+    sizes = sorted({r["N_tar"] for r in slow})
+    left.set_ylim(bottom=0)
+    left.set_title("10 m/s" + (f", 2 x {sizes[0]}" if len(sizes) == 1 else "")
+                   + "; paper: N_con < N_tot for the frictional models,\nN_cut << N_tot "
+                   "for all but the undamped frictionless", fontsize=8)
+    left.legend(fontsize=6, ncol=2)
+    fast = [r for r in rows if abs(r["v_col"] - 100.0) < 0.05 and r["B_off"] == 0.0]
+    common = [n for n in sorted({r["N_tar"] for r in fast}, reverse=True)
+              if {r["model_name"] for r in fast if r["N_tar"] == n} >= set(MODELS)]
+    n = common[0] if common else max((r["N_tar"] for r in fast), default=None)
+    for j, name in enumerate(MODELS):
+        runs = [r for r in fast if r["model_name"] == name and r["N_tar"] == n]
+        for k, (key, marker) in enumerate((("growth_efficiency", "o"), ("E_dis_tot", "D"))):
+            right.plot([j + 0.15 * (2 * k - 1)] * len(runs), [r[key] for r in runs], marker,
+                       color=colors[name], mfc="none" if k else colors[name], ms=7)
+    right.axhline(0, color="0.8", lw=0.8)
+    right.set_xticks(range(len(MODELS)), [m.replace(", ", ",\n") for m in MODELS], fontsize=7)
+    right.set_ylim(-1.1, 1.1)
+    right.set_ylabel("filled circles: f_gro; open diamonds: E_dis,tot / E_imp")
+    right.set_title(f"head-on, 100 m/s, 2 x {n} (each seed); paper: f_gro about 1 and "
+                    "E_dis,tot about E_imp,\nbut f_gro about -1, E_dis,tot << E_imp for the "
+                    "undamped frictionless", fontsize=8)
+    fig.tight_layout()
+    return save(fig, results, "fig_statements")
 
 
 def figure(summary: dict, results: Path) -> list[Path]:
@@ -295,7 +437,7 @@ def figure(summary: dict, results: Path) -> list[Path]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    cells = [(k, s) for k, by in summary.items() for s in by]
+    cells = [(k, s) for k, by in summary.items() if k not in STATEMENT_QUESTIONS for s in by]
     fig, axes = plt.subplots(2, len(cells), figsize=(3.6 * len(cells), 5.6), squeeze=False,
                              sharex="col")
     for col, (k, size) in enumerate(cells):
@@ -314,7 +456,7 @@ def figure(summary: dict, results: Path) -> list[Path]:
         ax.set_ylim(-1.05, 1.05)
         ax.set_xlim(-0.03, 1.03)
         ax.set_xticks([k / 12 for k in range(0, 13, 3)], ["0", "3/12", "6/12", "9/12", "1"])
-        ax.set_title(f"{k}: {q['model']}, {q['v_col']:g} m/s, 2 x {size}\npaper: "
+        ax.set_title(f"{k}: {s['model']}, {q['v_col']:g} m/s, 2 x {s['N_tar']}\npaper: "
                      f"{q['paper'].split(' (')[0]}", fontsize=8)
         ax.legend(fontsize=7)
         ax = axes[1, col]
@@ -353,6 +495,14 @@ def left_out(outcomes: list[dict]) -> list[dict]:
     return [listed(o) for o in outcomes if o.get("stop_reason") not in COUNTED]
 
 
+def cell(outcome: dict):
+    """Where a run goes in its question's summary: by its size (N per aggregate), and for a
+    question of several models, by "N, model" as well."""
+    if len(models_of(outcome["question"])) == 1:
+        return outcome["N_tar"]
+    return f"{outcome['N_tar']}, {model_name(outcome)}"
+
+
 def summarise(records: Path, results: Path, plot: bool = True) -> dict:
     loaded = load(records)
     outcomes = [o for o in loaded if o.get("stop_reason") in COUNTED]
@@ -361,16 +511,16 @@ def summarise(records: Path, results: Path, plot: bool = True) -> dict:
         r = scalars(o)
         r.update(time_end_over_tc=o.get("time_end_over_tc"),
                  **{f"f_gro_at_{t}_us": f for t, f in o["f_gro_at_us"].items()})
-        r.update(question=o["question"], model_name=next(
-            name for name, (kind, tvis, _) in MODELS.items()
-            if kind == o["model"] and tvis == (o.get("tvis") or 0.0)))
+        r.update(question=o["question"], model_name=model_name(o))
         rows.append(r)
     write_csv(results / "runs.csv", [{k: v for k, v in r.items() if k != "run"} for r in rows])
     by = defaultdict(lambda: defaultdict(list))
     for o in outcomes:
-        by[o["question"]][o["N_tar"]].append(o)
-    summary = {k: {n: question_summary(runs, len(QUESTIONS[k]["b_off2"]) == 12)
-                   for n, runs in sorted(by[k].items())}
+        by[o["question"]][cell(o)].append(o)
+    order = {name: j for j, name in enumerate(MODELS)}
+    summary = {k: {c: question_summary(runs, len(QUESTIONS[k]["b_off2"]) == 12)
+                   for c, runs in sorted(by[k].items(), key=lambda item: (
+                       item[1][0]["N_tar"], order[model_name(item[1][0])]))}
                for k in QUESTIONS if k in by}
     done = dict(study="paper_protocol", protocol="the paper's offsets B_off^2 = k/12 "
                 "(k = 0 ... 11, 12/12 grazing taken as f_gro 0) for b and d; one offset for "
@@ -383,6 +533,8 @@ def summarise(records: Path, results: Path, plot: bool = True) -> dict:
                 ended_at_cap=ended_at_cap(outcomes), left_out=left_out(loaded))
     if plot and summary:
         done["figures"] = [p.name for p in figure(summary, results)]
+        if any(k in summary for k in STATEMENT_QUESTIONS):
+            done["figures"] += [p.name for p in statements_figure(rows, results)]
     return done
 
 
@@ -394,7 +546,7 @@ def table(by_question: dict) -> list[str]:
     for k, sizes in by_question.items():
         q = QUESTIONS[k]
         for size, s in sizes.items():
-            lines.append(f"{k}: {q['model']}, {q['v_col']:g} m/s, 2 x {size}; paper: "
+            lines.append(f"{k}: {s['model']}, {q['v_col']:g} m/s, 2 x {s['N_tar']}; paper: "
                          f"{q['paper']}")
             lines.append("  B_off^2  f_gro by seed           N_con/N_tot  N_cut/N_tot")
             for b, con, cut in zip(s["B_off2"], s["N_con_over_N_tot"], s["N_cut_over_N_tot"]):
