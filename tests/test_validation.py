@@ -351,10 +351,26 @@ def test_the_paper_protocol_study_averages_twelve_offsets_and_keeps_every_record
             assert r["f_gro_at_1.6_us"] == r["growth_efficiency"]
     rows = {s["paper"].split(" (")[0]: s for s in summary["statements"]}
     assert rows["frictionless, undamped: E_dis,c = E_dis,tot"]["holds"]
-    # the runs gone, the records alone give the same results
+    # the runs gone, the records alone give the same results, and a campaign whose every
+    # run has its record kept is not run again (a new machine redoes nothing); --again
+    # runs it anew, the same collision bit for bit on the same build and ranks
     before = (results / "summary.json").read_text()
     shutil.rmtree(tmp_path / "runs")
     run_quick("paper_protocol", tmp_path, "--summary-only")
+    assert (results / "summary.json").read_text() == before
+    run_quick("paper_protocol", tmp_path, "--questions", "a")
+    assert not list((tmp_path / "runs").rglob("log.lammps"))
+    assert (results / "summary.json").read_text() == before
+    run_quick("paper_protocol", tmp_path, "--questions", "a", "--again", "0")
+    again = sorted((tmp_path / "runs").rglob("outcome.json"))
+    assert len(again) == 2
+    for path in again:
+        o = json.loads(path.read_text())
+        kept = json.loads((results / "records" / path.relative_to(tmp_path / "runs"))
+                          .read_text())
+        for key in ("stop_step", "n_largest", "n_fragments", "N_con", "N_cut",
+                    "dissipated_fraction", "energy_error"):
+            assert o[key] == kept[key], key
     assert (results / "summary.json").read_text() == before
     record = next((results / "records").rglob("outcome.json")).parent
     assert sorted(p.name for p in record.iterdir()) == sorted(
@@ -734,3 +750,26 @@ def test_the_papers_other_statements_are_asked_of_each_model_on_the_same_scenes(
     assert row["runs"] == len(frictional_slow)
     assert row["holds"] == all(r["N_con"] < r["n_total"] for r in frictional_slow)
     assert "fig_statements.png" in summary["figures"]
+    # a settled run whose continuation is not kept and whose run directory is gone (a lost
+    # machine) is named, with the command that runs it anew; a run made anew that is not
+    # the recorded collision (here its record altered) is not continued onto that record
+    first, second = sorted(rows, key=lambda r: r["seed"])
+    shutil.rmtree(tmp_path / "fixed" / "results" / "records" / first["record"])
+    shutil.rmtree(tmp_path / "protocol" / "runs" / first["record"])
+    outcome = protocol_results / "records" / second["record"] / "outcome.json"
+    o = json.loads(outcome.read_text())
+    outcome.write_text(json.dumps(dict(o, n_largest=o["n_largest"] + 1)))
+    shutil.rmtree(tmp_path / "fixed" / "results" / "records" / second["record"])
+    shutil.rmtree(tmp_path / "fixed" / "runs" / second["record"])
+    said = subprocess.run([sys.executable, str(ROOT / "validation" / "fixed_end.py"), "--quick",
+                           "--runs", str(tmp_path / "fixed" / "runs"), "--results",
+                           str(results), "--protocol-runs", str(tmp_path / "protocol" / "runs"),
+                           "--protocol-records", str(protocol_results / "records")],
+                          check=True, capture_output=True, text=True, timeout=600).stdout
+    assert f"{second['record']}: not continued: this run is not the one recorded " \
+           f"(n_largest {o['n_largest']} against {o['n_largest'] + 1})" in said
+    assert not (tmp_path / "fixed" / "runs" / second["record"]).exists()
+    summary = json.loads((results / "summary.json").read_text())["results"]
+    assert [m["record"] for m in summary["not_at_hand"]] == [first["record"]]
+    assert summary["not_at_hand"][0]["twelfths"] == 0
+    assert "--questions a --again 0" in said

@@ -122,6 +122,20 @@ def run_campaigns(specs: dict[str, dict], runs: Path, ranks: int,
     return where
 
 
+def all_kept(name: str, spec: dict, runs: Path) -> bool:
+    """Whether every run of the campaign ``name`` (``spec``, below ``runs``) has its small
+    record kept: a study whose results come from its records alone need not run it again
+    on a machine that has lost (or never had) its run directories."""
+    from jkrdt import rundir
+    from jkrdt.campaign import plan
+
+    where = campaign_paths({name: spec}, runs)[name]
+    records = records_of(where)
+    return records is not None and all(
+        (records / run.relative_to(where) / rundir.OUTCOME).exists()
+        for *_, run in plan(spec, where))
+
+
 #: how often (s) a running campaign's newly finished runs have their records kept
 KEEP_EVERY = 30.0
 

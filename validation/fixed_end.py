@@ -124,6 +124,41 @@ def to_continue(runs: Path, campaigns: str, cap_tc: float, twelfths=None,
     return [run for _, run in sorted(out)]
 
 
+#: what a run and its kept record must share to be the same collision (a run made anew
+#: by ``paper_protocol --again``: bit for bit on the same build and ranks, else not)
+SAME_RUN = ("stop_step", "n_largest", "n_fragments", "N_con", "N_cut", "dissipated_fraction")
+
+
+def not_the_record(run: Path, record: Path) -> str | None:
+    """How ``run``'s outcome differs from its kept record's (None: the same run, or no
+    record kept)."""
+    kept = rundir.read_outcome(record)
+    if kept is None:
+        return None
+    o = rundir.read_outcome(run)
+    return ", ".join(f"{k} {o.get(k)} against {kept.get(k)}" for k in SAME_RUN
+                     if o.get(k) != kept.get(k)) or None
+
+
+def not_at_hand(records: Path, kept: Path, runs: Path, campaigns: str,
+                cap_tc: float) -> list[dict]:
+    """The records of the ``campaigns`` that the settle rule ended before ``cap_tc`` whose
+    continuation is neither kept nor possible here: their run directory (its
+    final.restart) is gone with the machine that ran them. Each with its offset's k, for
+    ``paper_protocol --again k``, which runs it anew."""
+    out = []
+    for outcome in sorted(records.glob(f"{campaigns}/v*/b2_*/seed*/{rundir.OUTCOME}")):
+        o = json.loads(outcome.read_text())
+        where = outcome.parent.relative_to(records)
+        if o.get("stop_reason") != "settled" or o["time_end_over_tc"] >= cap_tc or \
+                (kept / where / rundir.CHECKS).exists() or \
+                (runs / where / rundir.FINAL_RESTART).exists():
+            continue
+        out.append(dict(record=str(where), seed=o["seed"], twelfths=round(12 * o["B_off"] ** 2),
+                        settled_tc=o["time_end_over_tc"]))
+    return out
+
+
 def offsets(records: Path, kept: Path, campaigns: str, cap_tc: float) -> list[dict]:
     """Each record of the ``campaigns`` (a glob below ``records``): its f_gro(t), with the
     continuation's checks appended where one was kept; f_gro at its own end and at the
@@ -276,6 +311,12 @@ def main(argv=None) -> int:
             if (runs / where / rundir.FINAL_RESTART).exists():     # ended, not yet kept
                 keep(runs / where, kept / where)
                 continue
+            differs = not_the_record(run, args.protocol_records / where)
+            if differs:
+                print(f"{where}: not continued: this run is not the one recorded "
+                      f"({differs}), so its continuation would not extend the record's "
+                      "checks", flush=True)
+                continue
             cmd = [str(BIN / "python"), __file__, "--one", str(run), str(runs / where),
                    "--cap", str(args.cap)]
             if args.np > 1:
@@ -284,6 +325,13 @@ def main(argv=None) -> int:
             if subprocess.run(cmd).returncode != 0:
                 raise SystemExit(f"{where}: the continuation stopped; run again to resume")
             keep(runs / where, kept / where)
+    missing = [] if args.campaigns else not_at_hand(args.protocol_records, kept,
+                                                    args.protocol_runs, campaigns, args.cap)
+    for m in missing:
+        print(f"{m['record']}: settled at {m['settled_tc']:.0f} t_c, not continued, and its "
+              f"run directory is not here: './run validate paper_protocol --stage paper "
+              f"--questions {args.question} --again {m['twelfths']}' runs it anew, then "
+              "this continues it", flush=True)
     rows = offsets(args.protocol_records, kept, campaigns, args.cap)
     cap_us = max((r["fixed_us"] for r in rows), default=None)
     # eq. (1) over the grid for a protocol question asked on the twelve offsets
@@ -295,7 +343,8 @@ def main(argv=None) -> int:
                              for r in rows],
                     settle_end=mean_or_open(rows, "f_gro_end") if twelve else {},
                     fixed_end=mean_or_open([r for r in rows if r["reaches_fixed_end"]],
-                                           "f_gro_fixed_end") if twelve else {}))
+                                           "f_gro_fixed_end") if twelve else {},
+                    not_at_hand=missing))
     print("\n".join(table(rows, done)))
     if rows:
         r = rows[0]

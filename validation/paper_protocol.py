@@ -27,7 +27,9 @@ ten times cheaper, two collisions side by side on the two ranks), then asked at 
 paper's 2 x 50000 where the placement says it decides something (``--stage paper``: seed
 1, each collision on all ranks; seed 2 for c). One campaign per question, size and offset
 (``RUNS/n<N>_<question>_b2_<B_off^2>``), in the order of QUESTIONS; a second call resumes
-them. Every run ends by the settle rule, its dt chosen by ``--dt auto`` for max |dE| /
+them, and a campaign whose runs all have their records kept is not run again, on this
+machine or a new one (``--again K`` runs the offset K/12 anew, bit for bit on the same
+build and ranks, for ``fixed_end`` to continue). Every run ends by the settle rule, its dt chosen by ``--dt auto`` for max |dE| /
 E_imp <= 1e-3 (vfra_size.TOLERANCE); at the paper's size a run that has not settled by
 PAPER_CAP_TC ends there and is averaged at its end (``summary.json``'s ``ended_at_cap``
 lists each with how far its f_gro moved over its last 1.6 us; ``end_rule.py`` measures
@@ -61,7 +63,8 @@ from pathlib import Path
 import numpy as np
 
 from bpca3d_models import MODELS, model_spec
-from common import campaign_study_parser, run_campaigns, save, study_paths, write_summary
+from common import (all_kept, campaign_study_parser, run_campaigns, save, study_paths,
+                    write_summary)
 from jkrdt import protocol, rundir
 from jkrdt.analysis.outcome import from_checks
 from jkrdt.analysis.summary import (b_off_average, b_off_groups, mean_diagnostics, scalars,
@@ -150,9 +153,17 @@ def campaign_specs(question: str, stage: dict) -> dict[str, dict]:
             for model in models for b2 in groups}
 
 
-def run_question(question: str, stage: dict, runs: Path, ranks: int) -> None:
-    """Every campaign of ``question`` at ``stage``, each one's records kept as it ends."""
+def run_question(question: str, stage: dict, runs: Path, ranks: int,
+                 again: tuple[int, ...] = ()) -> None:
+    """Every campaign of ``question`` at ``stage``, each one's records kept as its runs
+    end; a campaign whose every run has its record kept is not run again (the results
+    come from the records), unless its offset B_off^2 = k/12 has its k in ``again``."""
     for name, spec in campaign_specs(question, stage).items():
+        k = [round(12 * b2) for b2 in spec["b_off2"]]
+        if all_kept(name, spec, runs) and not set(k) & set(again):
+            print(f"{name}: every run's record is kept, not run again (--again "
+                  f"{' '.join(map(str, k))} runs it anew)", flush=True)
+            continue
         run_campaigns({name: spec}, runs, ranks, stage["ranks_per_run"])
 
 
@@ -570,13 +581,16 @@ def main(argv=None) -> int:
     p.add_argument("--questions", nargs="+", choices=sorted(QUESTIONS), default=None)
     p.add_argument("--summary-only", action="store_true",
                    help="run nothing: the results from the records kept so far")
+    p.add_argument("--again", type=int, nargs="+", default=(), metavar="K",
+                   help="run the offsets B_off^2 = K/12 again though their records are kept "
+                        "(for fixed_end, which continues a run from its run directory)")
     args = p.parse_args(argv)
     runs, results = study_paths(args, "paper_protocol")
     records = results / "records"
     stage = QUICK if args.quick else STAGES[args.stage]
     if not args.summary_only:
         for k in args.questions or list(QUESTIONS):
-            run_question(k, stage, runs, args.np)
+            run_question(k, stage, runs, args.np, tuple(args.again))
     done = summarise(records, results)
     print("\n".join(table(done["results"]["by_question"])))
     for o in done["ended_at_cap"]:
