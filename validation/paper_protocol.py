@@ -118,8 +118,10 @@ def model_name(outcome: dict) -> str:
 #: counts (10 grains) never let settle. Measured against the runs' real ends: end_rule.py
 PAPER_CAP_TC = 16000.0
 #: the paper-size campaigns started with the default cap (SettleRule.cap_tc) before the
-#: paper stage's was lowered: they keep it, so that they resume under the spec they began
-STARTED_WITH_DEFAULT_CAP = {"b": (0.0, 1 / 12, 2 / 12, 3 / 12, 6 / 12, 9 / 12)}
+#: paper stage's was lowered: they keep it, so that they resume (or run again, --again)
+#: under the spec they began. 9/12 began so too, but its run directory was lost with its
+#: machine at 4.72 us, before it ended, so it starts anew under the paper stage's cap
+STARTED_WITH_DEFAULT_CAP = {"b": (0.0, 1 / 12, 2 / 12, 3 / 12, 6 / 12)}
 #: the sizes a question is asked at: its seeds, and the ranks one collision shares
 STAGES = {"place": dict(n=5000, seeds=[1, 2], ranks_per_run=1),
           "paper": dict(n=50000, seeds=[1], ranks_per_run=2, more_seeds={"c": [1, 2]},
