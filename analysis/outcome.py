@@ -25,6 +25,7 @@ import numpy as np
 from MDAnalysis.analysis.base import AnalysisBase
 
 from jkrdt.aggregates import gyration_radius
+from jkrdt.stopping import STRETCH
 
 from . import fragments as frag
 
@@ -69,8 +70,9 @@ def from_checks(rows: list[dict], n_target: int, n_projectile: int) -> list[dict
 
 
 #: a body of at least this share of all grains (f_gro >= -0.5 for equal aggregates) whose
-#: r_g still grew when the settle rule ended the run may yet part (``stretching``)
-STRETCH_SHARE = 0.25
+#: r_g still grew when the settle rule ended the run may yet part (``stretching``): the
+#: share from which the rule itself watches shape (``jkrdt.stopping.STRETCH``)
+STRETCH_SHARE = STRETCH
 
 
 def stretching(table: list[dict], window: int, tolerance: float) -> dict | None:

@@ -7,6 +7,7 @@
 
 #include "atom.h"
 #include "comm.h"
+#include "domain.h"
 #include "error.h"
 #include "force.h"
 #include "group.h"
@@ -32,14 +33,14 @@ static double lammps_time(const Update *update)
 /* ---------------------------------------------------------------------- */
 
 FixJKRDTSettle::FixJKRDTSettle(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), window(5), tolerance(0.01), counts(1.0e-4), cap(-1.0), state(RUNNING),
-    rerun(false), last_check(-1),
-    now{0, 0, 0, 0.0}, departure(lmp),
+    Fix(lmp, narg, arg), window(5), tolerance(0.01), counts(1.0e-4), stretch(0.0), cap(-1.0),
+    state(RUNNING), rerun(false), last_check(-1),
+    now{0, 0, 0, 0.0, 0.0}, largest(-1), departure(lmp),
     time_origin(lammps_time(update)),
     dt_origin(update->dt), step_origin(update->ntimestep), table_append(false)
 {
-  const char *usage = "fix ID all jkr/dt/settle N window K tolerance f [counts c] [cap T] "
-                      "[depart yes|no|shadow] [table FILE] [append yes|no]";
+  const char *usage = "fix ID all jkr/dt/settle N window K tolerance f [counts c] "
+                      "[stretch s] [cap T] [depart yes|no|shadow] [table FILE] [append yes|no]";
   if (narg < 4) error->all(FLERR, "fix jkr/dt/settle: expected '{}'", usage);
   if (igroup != 0)
     error->all(FLERR, "fix jkr/dt/settle: the fragments are those of all atoms; use group all");
@@ -61,6 +62,12 @@ FixJKRDTSettle::FixJKRDTSettle(LAMMPS *lmp, int narg, char **arg) :
       if (!(counts >= 0.0 && counts < 1.0))
         error->all(FLERR, "fix jkr/dt/settle: counts is a fraction of all grains in [0, 1) "
                    "(got {}; 0 asks N_lar and the fragment count to stay unchanged)", counts);
+    } else if (key == "stretch") {
+      stretch = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
+      if (!(stretch >= 0.0 && stretch <= 1.0))
+        error->all(FLERR, "fix jkr/dt/settle: stretch is a fraction of all grains in [0, 1] "
+                   "(got {}; 0 does not watch shape, 0.25 watches a largest fragment of a "
+                   "quarter of the grains or more)", stretch);
     } else if (key == "cap") {
       cap = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
       if (!(cap > 0.0)) error->all(FLERR, "fix jkr/dt/settle: cap is a simulated time > 0");
@@ -149,7 +156,7 @@ void FixJKRDTSettle::setup(int)
    all ranks, each contact taken once (from the atom with the smaller ID)
 ------------------------------------------------------------------------- */
 
-FixJKRDTSettle::Partition FixJKRDTSettle::partition(Graph &graph) const
+FixJKRDTSettle::Partition FixJKRDTSettle::partition(Graph &graph)
 {
   auto *pair = PairJKRDT::active(lmp);
   const FixJKRDTContacts *C = pair ? pair->contacts() : nullptr;
@@ -196,14 +203,44 @@ FixJKRDTSettle::Partition FixJKRDTSettle::partition(Graph &graph) const
   p.n_fragments = atom->natoms - unions;
   p.contacts = static_cast<bigint>(edges.size() / 2);
   MPI_Allreduce(&dissipated, &p.dissipated, 1, MPI_DOUBLE, MPI_SUM, world);
+  largest = graph.largest();
+  p.gyration_radius = gyration_radius(graph, largest);
   return p;
+}
+
+/* ----------------------------------------------------------------------
+   r_g of the fragment of root k (equal grains), eq. (50) of Wada et al.
+   (2007): about the box centre, then shifted to the fragment's; 0 for none
+------------------------------------------------------------------------- */
+
+double FixJKRDTSettle::gyration_radius(Graph &graph, int k) const
+{
+  double centre[3], local[5] = {0, 0, 0, 0, 0}, total[5];
+  for (int d = 0; d < 3; d++) centre[d] = 0.5 * (domain->boxlo[d] + domain->boxhi[d]);
+  double **x = atom->x;
+  for (int i = 0; k >= 0 && i < atom->nlocal; i++) {
+    auto it = graph.index.find(atom->tag[i]);
+    if (it == graph.index.end() || graph.root(it->second) != k) continue;
+    local[0] += 1.0;
+    for (int d = 0; d < 3; d++) {
+      const double dx = x[i][d] - centre[d];
+      local[1 + d] += dx;
+      local[4] += dx * dx;
+    }
+  }
+  MPI_Allreduce(local, total, 5, MPI_DOUBLE, MPI_SUM, world);
+  if (!(total[0] > 0.0)) return 0.0;
+  double mean2 = 0.0;
+  for (int d = 0; d < 3; d++) mean2 += (total[1 + d] / total[0]) * (total[1 + d] / total[0]);
+  return std::sqrt(std::max(0.0, total[4] / total[0] - mean2));
 }
 
 void FixJKRDTSettle::write_check(Graph &graph)
 {
   if (table)
     table->write(graph, {simulated_time(), now.n_fragments, now.contacts,
-                         departure.departed_grains, departure.departed_fragments});
+                         departure.departed_grains, departure.departed_fragments, largest,
+                         now.gyration_radius});
 }
 
 double FixJKRDTSettle::simulated_time() const
@@ -239,7 +276,7 @@ void FixJKRDTSettle::end_of_step()
     const bool same = hi[0] - lo[0] <= allowed && hi[1] - lo[1] <= allowed;
     const double dissipating = now.dissipated - history.front().dissipated;
     if (same && (hi[2] - lo[2]) <= tolerance * hi[2] &&
-        dissipating <= tolerance * std::fabs(now.dissipated))
+        dissipating <= tolerance * std::fabs(now.dissipated) && !stretched())
       reason = SETTLED;
   }
   // the cap is met when the next check would lie beyond it
@@ -259,6 +296,25 @@ void FixJKRDTSettle::end_of_step()
       utils::logmesg(lmp, "jkr/dt/settle: new run for wider bins step {}\n", update->ntimestep);
     timer->force_timeout();
   }
+}
+
+/* ----------------------------------------------------------------------
+   stretch s: a largest fragment of at least s of all grains whose r_g grew
+   by more than f over the window is a body still being pulled apart (a neck
+   without rolling or sliding resistance stretches at constant N_lar and
+   contacts, dissipating nothing, and may part later): not settled. Where
+   the window's first r_g is unknown (< 0: a window read from a restart file
+   of an older build, which kept none), the rule waits for a window it knows.
+------------------------------------------------------------------------- */
+
+bool FixJKRDTSettle::stretched() const
+{
+  if (!(stretch > 0.0) ||
+      static_cast<double>(now.n_largest) < stretch * static_cast<double>(atom->natoms))
+    return false;
+  const double before = history.front().gyration_radius;
+  if (before < 0.0) return true;
+  return before > 0.0 && now.gyration_radius / before - 1.0 > tolerance;
 }
 
 void FixJKRDTSettle::stop(int reason)
@@ -300,10 +356,12 @@ double FixJKRDTSettle::compute_vector(int n)
 ------------------------------------------------------------------------- */
 
 static constexpr double RESTART_WALL = -2.5;    // never a step (older files: -1 or a step)
+// the same header, each check of the window with its largest fragment's r_g as well
+static constexpr double RESTART_SHAPE = -3.5;
 
 void FixJKRDTSettle::write_restart(FILE *fp)
 {
-  std::vector<double> list = {RESTART_WALL, table ? table->wall() : 0.0, time_origin,
+  std::vector<double> list = {RESTART_SHAPE, table ? table->wall() : 0.0, time_origin,
                               static_cast<double>(step_origin), dt_origin,
                               static_cast<double>(last_check),
                               static_cast<double>(history.size())};
@@ -312,6 +370,7 @@ void FixJKRDTSettle::write_restart(FILE *fp)
     list.push_back(static_cast<double>(h.n_fragments));
     list.push_back(static_cast<double>(h.contacts));
     list.push_back(h.dissipated);
+    list.push_back(h.gyration_radius);
   }
   if (comm->me == 0) {
     int size = static_cast<int>(list.size() * sizeof(double));
@@ -323,7 +382,8 @@ void FixJKRDTSettle::write_restart(FILE *fp)
 void FixJKRDTSettle::restart(char *buf)
 {
   auto *list = reinterpret_cast<double *>(buf);
-  if (list[0] == RESTART_WALL) {      // files of older builds start at the last check
+  const int per = list[0] == RESTART_SHAPE ? 5 : 4;    // older files: no r_g (-1, unknown)
+  if (list[0] == RESTART_WALL || list[0] == RESTART_SHAPE) {    // older: the last check
     if (table) table->continue_from(list[1]);
     time_origin = list[2];
     step_origin = static_cast<bigint>(list[3]);
@@ -334,9 +394,9 @@ void FixJKRDTSettle::restart(char *buf)
   const int n = static_cast<int>(list[1]);
   history.clear();
   for (int k = 0; k < n; k++) {
-    const double *p = list + 2 + 4 * k;
+    const double *p = list + 2 + per * k;
     history.push_back({static_cast<bigint>(p[0]), static_cast<bigint>(p[1]),
-                       static_cast<bigint>(p[2]), p[3]});
+                       static_cast<bigint>(p[2]), p[3], per == 5 ? p[4] : -1.0});
   }
   if (!history.empty()) now = history.back();
 }

@@ -1,7 +1,7 @@
 /* jkr/dt: fix jkr/dt/settle, which ends a run when the collision has ended.
 
-     fix ID all jkr/dt/settle N window K tolerance f [counts c] [cap T]
-                              [depart yes|no|shadow]
+     fix ID all jkr/dt/settle N window K tolerance f [counts c] [stretch s]
+                              [cap T] [depart yes|no|shadow]
 
    Every N steps it finds the fragments: the connected components of the
    bonded-contact graph of pair jkr/dt over all ranks. The collision has
@@ -13,10 +13,14 @@
    bonded contacts has varied by at most f of its largest value, and the
    energy dissipated over those K N steps is at most f of all the energy
    dissipated so far (restructuring by rolling and sliding has stopped: a
-   remnant that still compacts keeps dissipating). The run then stops at
-   that step. A run that reaches simulated time T after the fix was defined
-   without settling stops there, with reason "cap" (so a deck continued from
-   a restart file gets T more).
+   remnant that still compacts keeps dissipating), and, with stretch s > 0,
+   the largest fragment, where it holds at least s of all grains, has not
+   grown in r_g by more than f over those checks (a body held by a neck
+   without rolling or sliding resistance stretches at constant N_lar and
+   contacts, dissipating nothing, and may part later; default s = 0, shape
+   not watched). The run then stops at that step. A run that reaches
+   simulated time T after the fix was defined without settling stops there,
+   with reason "cap" (so a deck continued from a restart file gets T more).
 
    Each stop writes one line to the log,
      jkr/dt/settle: stop_reason settled step 123000 time 4.7e-07 N_lar 994 fragments 3 contacts 1350
@@ -74,7 +78,8 @@ class FixJKRDTSettle : public Fix {
   enum State { RUNNING = 0, SETTLED, CAP };
   struct Partition {
     bigint n_largest, n_fragments, contacts;
-    double dissipated;    // all channels of the contact fix's ledger, summed over ranks
+    double dissipated;         // all channels of the contact fix's ledger, summed over ranks
+    double gyration_radius;    // r_g of the largest fragment, m (< 0: unknown)
   };
 
   FixJKRDTSettle(class LAMMPS *, int, char **);
@@ -93,15 +98,19 @@ class FixJKRDTSettle : public Fix {
   int window;                    // K checks
   double tolerance;              // f: relative change of the contact count
   double counts;                 // c: change of N_lar and of the fragment count, of all grains
+  double stretch;                // s: shape watched in a largest fragment of s of all grains
   double cap;                    // simulated time at which the run stops unsettled; < 0 none
   int state;
   bool rerun;                    // this run was ended for the pair's wider bins
   bigint last_check;
   Partition now;
+  int largest;                      // the root of the largest fragment at the last check
   std::deque<Partition> history;    // the last K + 1 checks
 
   using Graph = FragmentGraph;    // the fragments (jkr_dt_fragments.h)
-  Partition partition(Graph &graph) const;
+  Partition partition(Graph &graph);
+  double gyration_radius(Graph &graph, int root) const;
+  bool stretched() const;
   SettleDeparture departure;     // depart yes|no|shadow (fix_jkr_dt_settle_depart.*)
   // the simulated time counts from an origin (time, step, dt) taken when the fix is defined
   // and carried through restart files, so that a continued run's times are the

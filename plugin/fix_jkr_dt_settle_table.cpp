@@ -23,7 +23,8 @@
    so that the cost of a run against simulated time, and its memory, come
    with every run.
 
-   Every rank holds the whole contact graph, so only r_g needs a reduction.
+   Every rank holds the whole contact graph; the fix finds the largest
+   fragment and its r_g (which its rule watches) and hands both over.
    Rows are flushed as they are written: a run that is killed leaves whole
    rows, and one continued from a restart file appends rows for steps that
    may already be there (the later row is the one that counts).             */
@@ -32,7 +33,6 @@
 
 #include "atom.h"
 #include "comm.h"
-#include "domain.h"
 #include "error.h"
 #include "info.h"
 #include "platform.h"
@@ -76,59 +76,23 @@ void SettleTable::continue_from(double seconds)
 
 void SettleTable::write(FragmentGraph &graph, const Check &check)
 {
-  // the fragments of more than one grain: their sizes and smallest atom IDs, by root
+  // the fragments of more than one grain, by root; the largest is the check's
   const int nodes = static_cast<int>(graph.parent.size());
-  std::vector<tagint> smallest(nodes, -1);
-  for (const auto &entry : graph.index) {
-    const int r = graph.root(entry.second);
-    if (smallest[r] < 0 || entry.first < smallest[r]) smallest[r] = entry.first;
-  }
+  const int largest = check.largest;
   const bigint singles = atom->natoms - static_cast<bigint>(nodes);
-  bigint cum4 = singles, cum16 = singles, first = 0, second = singles > 0 ? 1 : 0;
-  int largest = -1;
+  bigint cum4 = singles, cum16 = singles, second = singles > 0 ? 1 : 0;
   for (int k = 0; k < nodes; k++) {
     if (graph.parent[k] != k) continue;
     const bigint n = graph.size[k];
     if (n <= 4) cum4 += n;
     if (n <= 16) cum16 += n;
-    const bool ahead = largest < 0 || n > first || (n == first && smallest[k] < smallest[largest]);
-    if (ahead) {
-      second = std::max(second, first);
-      first = n;
-      largest = k;
-    } else {
-      second = std::max(second, n);
-    }
+    if (k != largest) second = std::max(second, n);
   }
-  if (largest < 0) {    // no contact at all: every fragment is one grain
-    first = atom->natoms > 0 ? 1 : 0;
-    second = atom->natoms > 1 ? 1 : 0;
-  }
+  bigint first = largest >= 0 ? graph.size[largest] : (atom->natoms > 0 ? 1 : 0);
+  if (largest < 0) second = atom->natoms > 1 ? 1 : 0;    // every fragment is one grain
   bigint inside = 0;
   for (size_t e = 0; largest >= 0 && e < graph.edges.size(); e += 2)
     if (graph.root(graph.index.at(graph.edges[e])) == largest) inside++;
-
-  // r_g of the largest fragment, eq. (50): about the box centre, then shifted
-  double centre[3], local[5] = {0, 0, 0, 0, 0}, total[5];
-  for (int d = 0; d < 3; d++) centre[d] = 0.5 * (domain->boxlo[d] + domain->boxhi[d]);
-  double **x = atom->x;
-  for (int i = 0; largest >= 0 && i < atom->nlocal; i++) {
-    auto it = graph.index.find(atom->tag[i]);
-    if (it == graph.index.end() || graph.root(it->second) != largest) continue;
-    local[0] += 1.0;
-    for (int d = 0; d < 3; d++) {
-      const double dx = x[i][d] - centre[d];
-      local[1 + d] += dx;
-      local[4] += dx * dx;
-    }
-  }
-  MPI_Allreduce(local, total, 5, MPI_DOUBLE, MPI_SUM, world);
-  double rg = 0.0;
-  if (total[0] > 0.0) {
-    double mean2 = 0.0;
-    for (int d = 0; d < 3; d++) mean2 += (total[1 + d] / total[0]) * (total[1 + d] / total[0]);
-    rg = std::sqrt(std::max(0.0, total[4] / total[0] - mean2));
-  }
   double memory[3], largest_memory[2];
   Info(lmp).get_memory_info(memory);    // MB: LAMMPS's count, the heap, the peak resident size
   memory[1] = memory[2];
@@ -137,7 +101,8 @@ void SettleTable::write(FragmentGraph &graph, const Check &check)
   fmt::print(file,
              "{},{:.17g},{},{},{},{},{},{},{:.17g},{},{},{},{:.17g},{:.17g},{:.6g},{:.6g},{:.6g}\n",
              update->ntimestep, check.time, atom->natoms, first, second, check.n_fragments,
-             check.contacts, inside, rg, singles, cum4, cum16, check.departed_grains,
+             check.contacts, inside, check.gyration_radius, singles, cum4, cum16,
+             check.departed_grains,
              check.departed_fragments, wall(), largest_memory[0],
              largest_memory[1]);
   fflush(file);

@@ -21,6 +21,8 @@ class SettleTable : protected Pointers {
     double time;                                 // simulated time, s
     bigint n_fragments, contacts;
     double departed_grains, departed_fragments;    // so far
+    int largest;                                 // the largest fragment's root (-1: none)
+    double gyration_radius;                      // its r_g, m (eq. 50)
   };
   // opens FILE on rank 0 (append: add to it) and starts the wall clock of the table
   SettleTable(class LAMMPS *lmp, const std::string &path, bool append);

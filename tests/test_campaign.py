@@ -64,6 +64,27 @@ def test_resume_skips_finished_runs(campaign):
     assert json.loads(redo.read_text())["n_largest"] == kept["n_largest"]
 
 
+def test_a_campaign_recorded_before_the_rule_watched_shape_resumes_without_it(campaign,
+                                                                               tmp_path):
+    # a campaign.json written before SettleRule.stretch existed holds the rule of its runs:
+    # shape not watched. Its spec with "stretch": 0 resumes it (nothing to redo here); the
+    # default rule, which watches shape, is another spec, refused with the difference named
+    import shutil
+
+    spec, runs, _ = campaign
+    old = tmp_path / "old"
+    shutil.copytree(runs, old)
+    record = json.loads((old / "campaign.json").read_text())
+    del record["spec"]["settle"]["stretch"]
+    (old / "campaign.json").write_text(json.dumps(record))
+    with pytest.raises(ValueError, match="holds the runs of another spec.*stretch"):
+        run_campaign(spec, old, progress=False)
+    pinned = tmp_path / "pinned.json"
+    pinned.write_text(json.dumps(dict(SPEC, settle=dict(SPEC["settle"], stretch=0.0))))
+    assert run_campaign(pinned, old, progress=False) == dict(runs=6, skipped=6, ran=0,
+                                                              failed=[])
+
+
 def test_summary_is_the_b_off_weighted_average(campaign):
     _, runs, _ = campaign
     summary = summarise(runs)

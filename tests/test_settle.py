@@ -6,6 +6,7 @@ analysis finds independently in the dumps: over the window that let the run stop
 fragments did not change, and the plugin's union-find over all ranks gives the same
 N_lar and number of fragments as analysis.fragments on the contact dump."""
 
+import dataclasses
 import gc
 import subprocess
 import tempfile
@@ -199,16 +200,12 @@ def test_truncated_dump_is_refused_unless_partial(settled, tmp_path, cut):
     assert copies() <= before, "the readable copy of a cut-off dump outlived its reader"
 
 
-def test_a_frictionless_hinge_opening_counts_as_settled_and_the_outcome_says_so(tmp_path):
-    """What the rule does not watch: shape. Three frictionless grains bent at 90 degrees
-    (two contacts at the equilibrium distance 2R - delta_0), the end grains moving apart
-    at 1 m/s across their arms, open like a hinge: no rolling or sliding resistance, so
-    the contacts, N_lar = 3 and the fragments hold still and nothing is dissipated, and
-    the rule ends the run after one window while the hinge is still opening (r_g of
-    three grains goes from 2/3 d at 90 degrees towards sqrt(2/3) d straight). The outcome
-    measures the growth of r_g over the rule's window from checks.csv and flags the body
-    as still stretching, with a warning in the summary."""
-    from jkrdt.analysis.run import summary_text
+def hinge(where):
+    """Three frictionless grains bent at 90 degrees (two contacts at the equilibrium
+    distance 2R - delta_0), the end grains moving apart at 1 m/s across their arms, so
+    that they open like a hinge: no rolling or sliding resistance, so the contacts, N_lar
+    = 3 and the fragments hold still and nothing is dissipated, while r_g of the three
+    goes from 2/3 d at 90 degrees to sqrt(2/3) d straight. Returns (run, d)."""
     from jkrdt.collision import Collision
 
     d = 2 * R - S.delta0
@@ -217,9 +214,61 @@ def test_a_frictionless_hinge_opening_counts_as_settled_and_the_outcome_says_so(
     v = np.array([[0.0, 0.0, 0.0], [0.0, -u, 0.0], [-u, 0.0, 0.0]])
     scene = scene_module.Scene(ICE, 2, 1, v_col=u, seed=1, kind="bpca", dim=3,
                                model="frictionless")
-    run = rundir.write(tmp_path / "hinge", scene, placed=Collision(
-        x=x, v=v, body=np.array([1, 1, 2]), radius=R, meta=dict(b=0.0, gap=0.0)))
+    return rundir.write(where, scene, placed=Collision(
+        x=x, v=v, body=np.array([1, 1, 2]), radius=R, meta=dict(b=0.0, gap=0.0))), d
+
+
+def test_a_frictionless_hinge_settles_once_it_has_opened(tmp_path):
+    """The rule watches shape (stretch 0.25, the default): the hinge's r_g grows by more
+    than the tolerance over every window while it opens, so the run goes on until it
+    is straight, where r_g is at its largest, sqrt(2/3) d, and grows no more; the outcome
+    flags nothing."""
+    from jkrdt.analysis.run import summary_text
+
+    run, d = hinge(tmp_path / "hinge")
+    assert RULE.stretch == 0.25
     with Session(run, run, every=1, settle=RULE, variables=dict(frames=1)) as s:
+        s.run_until_settled(progress=False)
+        assert s.stop_reason == "settled"
+    out = analyse_run(run, plots=False)
+    assert out["n_largest"] == 3 and out["dissipated_fraction"] == 0.0
+    rows = read_csv(run / rundir.CHECKS)
+    r_g = [r["gyration_radius_largest"] for r in rows]
+    assert len(rows) > 3 * (RULE.window + 1)
+    # every window before the last grew by more than the tolerance; the last did not
+    growth = [b / a - 1 for a, b in zip(r_g, r_g[RULE.window:])]
+    assert all(g > RULE.tolerance for g in growth[:-1]) and growth[-1] <= RULE.tolerance
+    # straight, to within the last check's step past r_g's maximum (flat there)
+    assert r_g[-1] == pytest.approx(np.sqrt(2 / 3) * d, rel=1e-3)
+    assert out["shape_at_end"]["stretching"] is False
+    assert "a neck may still part it" not in summary_text(out)
+    # validation/end_rule.py's replay of the rule on a run's checks (counts, contacts and
+    # shape; nothing is dissipated here) stops where the fix stopped, and without shape
+    # where the rule without it stops (after one window)
+    from jkrdt.analysis.outcome import from_checks
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "validation"))
+    try:
+        from end_rule import settle_replay
+    finally:
+        sys.path.pop(0)
+    table = from_checks(read_csv(run / rundir.CHECKS), 2, 1)
+    for row, raw in zip(table, rows):
+        row["contacts"] = raw["contacts"]
+    assert settle_replay(table, RULE, shape=True) == len(rows) - 1
+    assert settle_replay(table, RULE, shape=False) == RULE.window
+
+
+def test_a_frictionless_hinge_opening_counts_as_settled_without_shape_and_says_so(tmp_path):
+    """Without shape watched (stretch 0, the rule of the runs made before it): the rule
+    ends the run after one window while the hinge is still opening. The outcome measures
+    the growth of r_g over the rule's window from checks.csv and flags the body as still
+    stretching, with a warning in the summary."""
+    from jkrdt.analysis.run import summary_text
+
+    run, d = hinge(tmp_path / "hinge")
+    rule = dataclasses.replace(RULE, stretch=0.0)
+    with Session(run, run, every=1, settle=rule, variables=dict(frames=1)) as s:
         s.run_until_settled(progress=False)
         assert s.stop_reason == "settled"
     out = analyse_run(run, plots=False)

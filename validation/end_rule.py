@@ -12,6 +12,13 @@ cap (the paper stage's, ``paper_protocol.PAPER_CAP_TC``): a run stops at the fir
 at or after it. The issue allows such a rule for its campaigns only if it moves no
 committed paper-size f_gro by more than 0.02.
 
+And a rule that stops later: the settle rule's counts and contacts (its dissipation is
+not in the checks) with, as well, "not while the largest fragment, of at least a quarter
+of the grains, grows in r_g by more than the tolerance over the window" (``stretching``
+of the analysis, the warning's own test), replayed on every run that ``fixed_end``
+continued to 16000 t_c (its record's checks and the continuation's), against f_gro at
+that fixed end: whether watching shape gives the fixed end's outcome, and how much sooner.
+
 The other way round, it lists every committed record (of every study that keeps them)
 that the settle rule ended while the largest fragment's gyration radius r_g was still
 growing by more than the rule's own tolerance (1 %) over its last window: a body being
@@ -102,6 +109,79 @@ def stretching(records: list[Path], rule: SettleRule = SettleRule()) -> dict:
     return out
 
 
+#: the runs fixed_end continued: (its records of the continuations, the records continued)
+CONTINUED = [(HERE / "fixed_end" / "records", HERE / "paper_protocol" / "records"),
+             (HERE / "fixed_end" / "size_trend" / "records", HERE / "size_trend" / "records")]
+
+
+def settle_replay(rows: list[dict], rule: SettleRule, shape: bool) -> int | None:
+    """The first check (index into ``rows``, ``from_checks`` with each row's ``contacts``)
+    at which ``rule``'s counts and contacts have held over its window, and with ``shape``
+    the largest fragment is not being stretched (``stretching_at``); None: never."""
+    allowed = int(rule.counts * rows[0]["n_total"])
+    for k in range(rule.window, len(rows)):
+        span = rows[k - rule.window:k + 1]
+        ranges = [max(r[key] for r in span) - min(r[key] for r in span)
+                  for key in ("n_largest", "n_fragments", "contacts")]
+        if ranges[0] > allowed or ranges[1] > allowed or \
+                ranges[2] > rule.tolerance * max(r["contacts"] for r in span):
+            continue
+        if shape and (stretching_at(rows[:k + 1], rule.window, rule.tolerance) or {}).get(
+                "stretching"):
+            continue
+        return k
+    return None
+
+
+def watched_shape(rule: SettleRule = SettleRule()) -> dict:
+    """Each continued run's f_gro where the settle rule's counts and contacts would have
+    ended it, and where they would have with its shape watched too, against f_gro at the
+    fixed end (its last check): the largest move of each, and whether watching shape
+    keeps every one within ALLOWED."""
+    runs = []
+    for kept, records in CONTINUED:
+        for more in sorted(kept.rglob(rundir.CHECKS)):
+            record = records / more.parent.relative_to(kept)
+            meta = rundir.read_metadata(record)
+            t_c = rundir.from_metadata(meta).scales.t_c
+            raw = read_csv(record / rundir.CHECKS) + read_csv(more)
+            contacts = {int(r["step"]): int(r["contacts"]) for r in raw}    # last written
+            rows = from_checks(raw, meta["N_tar"], meta["N_pro"])
+            for r in rows:
+                r["contacts"] = contacts[r["step"]]
+            end = next(k for k, r in enumerate(rows)
+                       if r["step"] == int(read_csv(record / rundir.CHECKS)[-1]["step"]))
+            run = dict(run=named(record), N_tar=meta["N_tar"], B_off2=round(meta["B_off"] ** 2, 4),
+                       seed=meta["seed"], settle_end_us=rows[end]["time"] * 1e6,
+                       f_gro_settle_end=rows[end]["growth_efficiency"],
+                       fixed_end_us=rows[-1]["time"] * 1e6,
+                       f_gro_fixed_end=rows[-1]["growth_efficiency"])
+            for name, shape in (("counts", False), ("shape", True)):
+                k = settle_replay(rows, rule, shape)
+                run[f"{name}_stop_us"] = None if k is None else rows[k]["time"] * 1e6
+                run[f"{name}_stop_tc"] = None if k is None else rows[k]["time"] / t_c
+                run[f"f_gro_{name}"] = None if k is None else rows[k]["growth_efficiency"]
+            runs.append(run)
+    out = dict(runs=runs)
+    for name in ("counts", "shape"):
+        moved = [abs(r[f"f_gro_{name}"] - r["f_gro_fixed_end"]) for r in runs
+                 if r[f"f_gro_{name}"] is not None]
+        out[f"largest_move_{name}"] = max(moved) if moved else None
+        out[f"all_stop_{name}"] = all(r[f"f_gro_{name}"] is not None for r in runs)
+    out["allowed"] = bool(out["all_stop_shape"] and out["largest_move_shape"] <= ALLOWED)
+    print(f"the settle rule's counts and contacts, with and without shape watched, on the "
+          f"{len(runs)} runs continued to the fixed end (f_gro there):")
+    for r in runs:
+        print(f"  {r['run']}: settle end {r['settle_end_us']:.2f} us {r['f_gro_settle_end']:+.3f};"
+              f" counts {r['counts_stop_us']:.2f} us {r['f_gro_counts']:+.3f}; shape "
+              f"{r['shape_stop_us']:.2f} us {r['f_gro_shape']:+.3f}; fixed end "
+              f"{r['fixed_end_us']:.2f} us {r['f_gro_fixed_end']:+.3f}")
+    print(f"  largest move against the fixed end: counts {out['largest_move_counts']:.3f}, "
+          f"shape {out['largest_move_shape']:.3f} "
+          f"({'allowed' if out['allowed'] else 'refused'})")
+    return out
+
+
 def named(run: Path) -> str:
     return str(run.relative_to(HERE.parent) if run.is_relative_to(HERE.parent) else run)
 
@@ -149,9 +229,28 @@ def main(argv=None) -> int:
             print(f"  B_off^2 {r['B_off'] ** 2:.4f}: stops {stop}; the run ended at "
                   f"{r['end_ns']:.0f} ns with {r['f_gro_end']:+.3f}")
     out["caps"] = [capped(runs, PAPER_CAP_TC)]
+    path = HERE / "paper_protocol" / "end_rule.json"
+    if path.exists():
+        keep_gone_rows(out, json.loads(path.read_text()))
     out["stretching_at_end"] = stretching(sorted(HERE.glob("*/records")))
-    (HERE / "paper_protocol" / "end_rule.json").write_text(json.dumps(out, indent=1) + "\n")
+    out["shape_watched"] = watched_shape()
+    path.write_text(json.dumps(out, indent=1) + "\n")
     return 0
+
+
+def keep_gone_rows(out: dict, before: dict) -> None:
+    """Rows of the earlier end_rule.json for run directories that are gone (a running run
+    given on the command line, lost with its machine: 9/12 at 3.9 us) are kept, so that a
+    later call loses no measurement; each rule's largest move is taken over all its rows."""
+    for now, then in zip(out["rules"] + out["caps"], before.get("rules", []) +
+                         before.get("caps", [])):
+        names = {r["run"] for r in now["runs"]}
+        now["runs"] += [r for r in then["runs"] if r["run"] not in names
+                        and not (HERE.parent / r["run"]).exists()]
+        key = ("f_gro_stop", "f_gro_end")
+        moved = [abs(r[key[0]] - r[key[1]]) for r in now["runs"] if r[key[0]] is not None]
+        now["largest_move"] = max(moved) if moved else None
+        now["allowed"] = bool(moved) and max(moved) <= ALLOWED
 
 
 if __name__ == "__main__":

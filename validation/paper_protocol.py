@@ -122,10 +122,19 @@ PAPER_CAP_TC = 16000.0
 #: under the spec they began. 9/12 began so too, but its run directory was lost with its
 #: machine at 4.72 us, before it ended, so it starts anew under the paper stage's cap
 STARTED_WITH_DEFAULT_CAP = {"b": (0.0, 1 / 12, 2 / 12, 3 / 12, 6 / 12)}
+#: the campaigns begun before the settle rule watched shape (``SettleRule.stretch``), per
+#: stage: they keep the rule they ran with (stretch 0), so that they resume, or run again
+#: (--again) to the same end, under the spec they began; every other campaign watches it
+STARTED_WITHOUT_SHAPE = {
+    "place": {"a": (0.0,), "b": tuple(TWELFTHS_FIRST), "c": (0.25,)},
+    "paper": {"a": (0.0,), "c": (0.25,),
+              "b": (0.0, 1 / 12, 2 / 12, 3 / 12, 4 / 12, 6 / 12)}}
 #: the sizes a question is asked at: its seeds, and the ranks one collision shares
-STAGES = {"place": dict(n=5000, seeds=[1, 2], ranks_per_run=1),
+STAGES = {"place": dict(n=5000, seeds=[1, 2], ranks_per_run=1,
+                        no_shape=STARTED_WITHOUT_SHAPE["place"]),
           "paper": dict(n=50000, seeds=[1], ranks_per_run=2, more_seeds={"c": [1, 2]},
-                        cap_tc=PAPER_CAP_TC, default_cap=STARTED_WITH_DEFAULT_CAP)}
+                        cap_tc=PAPER_CAP_TC, default_cap=STARTED_WITH_DEFAULT_CAP,
+                        no_shape=STARTED_WITHOUT_SHAPE["paper"])}
 #: how a run may end and be averaged here: settled, or at the cap of its stage
 COUNTED = COMPLETE + ("cap",)
 #: the span (us) before a capped run's end over which its f_gro range is reported
@@ -143,10 +152,16 @@ def campaign_specs(question: str, stage: dict) -> dict[str, dict]:
     kept = stage.get("default_cap", {}).get(question, ())
     models = models_of(question)
 
-    def settle(b2):    # the stage's cap, unless the campaign began with the default one
-        if "cap_tc" not in stage or any(abs(b2[0] - k) < 1e-9 for k in kept):
-            return {}
-        return dict(settle=dict(cap_tc=stage["cap_tc"]))
+    def began(b2, of):    # whether the campaign of offset b2[0] is among ``of``'s
+        return any(abs(b2[0] - k) < 1e-9 for k in of)
+
+    def settle(b2):    # the stage's cap, unless the campaign began with the default one;
+        rule = {}      # shape not watched where the campaign began without it
+        if "cap_tc" in stage and not began(b2, kept):
+            rule["cap_tc"] = stage["cap_tc"]
+        if began(b2, stage.get("no_shape", {}).get(question, ())):
+            rule["stretch"] = 0.0
+        return dict(settle=rule) if rule else {}
 
     return {f"n{stage['n']}/{question}/b2_{b2[0]:.4f}" + ("_all" if len(b2) > 1 else "")
             + (f"/{model}" if len(models) > 1 else ""):

@@ -63,7 +63,7 @@ from . import protocol, rundir
 from .aggregates import BUILDERS
 from .materials import material
 from .scene import BONDS, Scene
-from .stopping import SettleRule
+from .stopping import BEFORE, SettleRule
 from .timestep import AUTO_TOLERANCE, DT_STABLE
 
 DEFAULTS = dict(kind="bpca", dim=3, material="ice", material_overrides={}, radius=1.0e-7,
@@ -223,6 +223,8 @@ def own(campaign: Path, spec: dict, fresh: bool = False) -> None:
         path.unlink()
     elif path.exists():
         had = json.loads(path.read_text())
+        if isinstance(had["spec"].get("settle"), dict):     # a rule of fewer fields: theirs
+            had["spec"]["settle"] = dict(BEFORE, **had["spec"]["settle"])
         differ = [k for k in sorted(set(had["spec"]) | set(want))
                   if as_numbers(had["spec"].get(k)) != as_numbers(want.get(k))]
         if differ:

@@ -331,10 +331,11 @@ def time_step(value: str):
 
 
 def settle_rule(args) -> SettleRule:
-    """The settle rule of --check, --window, --settle-tol, --settle-counts and --cap."""
+    """The settle rule of --check, --window, --settle-tol, --settle-counts, --stretch and
+    --cap."""
     try:
         return SettleRule(check_tc=args.check, window=args.window, tolerance=args.settle_tol,
-                          counts=args.settle_counts, cap_tc=args.cap)
+                          counts=args.settle_counts, stretch=args.stretch, cap_tc=args.cap)
     except ValueError as err:
         raise SystemExit(f"jkrdt: {err}") from None
 
@@ -358,6 +359,10 @@ def add_settle_options(p) -> None:
                    help="allowed change of N_lar and of the number of fragments over the "
                         "window, as a fraction of all grains (default %(default)g: unchanged "
                         "below 10^4 grains)")
+    p.add_argument("--stretch", type=float, default=d.stretch,
+                   help="watch the shape of a largest fragment of this share of all grains "
+                        "or more: not settled while its r_g grows by more than --settle-tol "
+                        "over the window (default %(default)g; 0: shape not watched)")
 
 
 def model_name(text: str) -> str:
