@@ -641,6 +641,43 @@ def test_the_fixed_end_study_continues_settled_runs_as_the_same_collision(tmp_pa
         assert 1200 * t_c <= more[-1]["time"] < 1200 * t_c + every * meta["dt_over_tc"] * t_c
         assert r["fixed_end_us"] == pytest.approx(more[-1]["time"] * 1e6, rel=1e-12)
         assert r["f_gro_fixed_end"] == (more[-1]["n_largest"] - 24) / 24
+    # --shape continues a run under the settle rule with shape watched instead: these
+    # shattered runs (a largest fragment of a few grains, below a quarter of the 48, so
+    # shape is not watched) stay settled, so each continuation settles at its first check,
+    # one check after the run's end, with f_gro as it was
+    shaped = run_quick("fixed_end", tmp_path / "shaped", "--np", "2", "--shape",
+                       "--protocol-runs", str(tmp_path / "protocol" / "runs"),
+                       "--protocol-records", str(protocol_results / "records"))
+    for row in json.loads((shaped / "summary.json").read_text())["results"]["offsets"]:
+        assert row["continued"] and row["shape_end"] and not row["reaches_fixed_end"]
+        more = read_csv(shaped / "records" / row["record"] / "checks.csv")
+        before = read_csv(tmp_path / "protocol" / "runs" / row["record"] / "checks.csv")
+        every = before[-1]["step"] - before[-2]["step"]
+        assert [c["step"] for c in more][-1] == before[-1]["step"] + every
+        assert row["f_gro_fixed_end"] == row["f_gro_end"]
+    # a settled run whose continuation is not kept and whose run directory is gone (a lost
+    # machine) is named, with the command that runs it anew; a run made anew that is not
+    # the recorded collision (here its record altered) is not continued onto that record
+    first, second = sorted(rows, key=lambda r: r["seed"])
+    shutil.rmtree(tmp_path / "fixed" / "results" / "records" / first["record"])
+    shutil.rmtree(tmp_path / "protocol" / "runs" / first["record"])
+    outcome = protocol_results / "records" / second["record"] / "outcome.json"
+    o = json.loads(outcome.read_text())
+    outcome.write_text(json.dumps(dict(o, n_largest=o["n_largest"] + 1)))
+    shutil.rmtree(tmp_path / "fixed" / "results" / "records" / second["record"])
+    shutil.rmtree(tmp_path / "fixed" / "runs" / second["record"])
+    said = subprocess.run([sys.executable, str(ROOT / "validation" / "fixed_end.py"), "--quick",
+                           "--runs", str(tmp_path / "fixed" / "runs"), "--results",
+                           str(results), "--protocol-runs", str(tmp_path / "protocol" / "runs"),
+                           "--protocol-records", str(protocol_results / "records")],
+                          check=True, capture_output=True, text=True, timeout=600).stdout
+    assert f"{second['record']}: not continued: this run is not the one recorded " \
+           f"(n_largest {o['n_largest']} against {o['n_largest'] + 1})" in said
+    assert not (tmp_path / "fixed" / "runs" / second["record"]).exists()
+    summary = json.loads((results / "summary.json").read_text())["results"]
+    assert [m["record"] for m in summary["not_at_hand"]] == [first["record"]]
+    assert summary["not_at_hand"][0]["twelfths"] == 0
+    assert "--questions a --again 0" in said
 
 
 def test_a_stopped_campaign_keeps_the_records_of_the_runs_it_finished(tmp_path):
@@ -750,26 +787,3 @@ def test_the_papers_other_statements_are_asked_of_each_model_on_the_same_scenes(
     assert row["runs"] == len(frictional_slow)
     assert row["holds"] == all(r["N_con"] < r["n_total"] for r in frictional_slow)
     assert "fig_statements.png" in summary["figures"]
-    # a settled run whose continuation is not kept and whose run directory is gone (a lost
-    # machine) is named, with the command that runs it anew; a run made anew that is not
-    # the recorded collision (here its record altered) is not continued onto that record
-    first, second = sorted(rows, key=lambda r: r["seed"])
-    shutil.rmtree(tmp_path / "fixed" / "results" / "records" / first["record"])
-    shutil.rmtree(tmp_path / "protocol" / "runs" / first["record"])
-    outcome = protocol_results / "records" / second["record"] / "outcome.json"
-    o = json.loads(outcome.read_text())
-    outcome.write_text(json.dumps(dict(o, n_largest=o["n_largest"] + 1)))
-    shutil.rmtree(tmp_path / "fixed" / "results" / "records" / second["record"])
-    shutil.rmtree(tmp_path / "fixed" / "runs" / second["record"])
-    said = subprocess.run([sys.executable, str(ROOT / "validation" / "fixed_end.py"), "--quick",
-                           "--runs", str(tmp_path / "fixed" / "runs"), "--results",
-                           str(results), "--protocol-runs", str(tmp_path / "protocol" / "runs"),
-                           "--protocol-records", str(protocol_results / "records")],
-                          check=True, capture_output=True, text=True, timeout=600).stdout
-    assert f"{second['record']}: not continued: this run is not the one recorded " \
-           f"(n_largest {o['n_largest']} against {o['n_largest'] + 1})" in said
-    assert not (tmp_path / "fixed" / "runs" / second["record"]).exists()
-    summary = json.loads((results / "summary.json").read_text())["results"]
-    assert [m["record"] for m in summary["not_at_hand"]] == [first["record"]]
-    assert summary["not_at_hand"][0]["twelfths"] == 0
-    assert "--questions a --again 0" in said

@@ -10,6 +10,7 @@ final.restart to that time with the settle checks written but the rule off, so t
 f_gro is read at one fixed end for every offset (a run that hit the cap is there already).
 
     ./run validate fixed_end                 # continue each settled run (hours; resumable)
+    ./run validate fixed_end --shape         # ... until it settles with shape watched
     ./run validate fixed_end --summary-only  # the results from the records kept so far
 
 Continuations run one at a time over --np ranks, in the protocol's order of offsets
@@ -59,19 +60,22 @@ QUICK_CAP_TC = 1200.0
 KEPT = (rundir.CHECKS, rundir.META)
 
 
-def continue_run(run: Path, out: Path, cap_tc: float) -> None:
+def continue_run(run: Path, out: Path, cap_tc: float, shape: bool = False) -> None:
     """Continue ``run`` (ended by the settle rule) in ``out`` to ``cap_tc`` with the settle
-    checks on and the rule off, from its final.restart, or from ``out``'s newer restart
-    file where an earlier call was cut off. Every rank of COMM_WORLD calls this."""
+    checks on and the rule off (``shape``: on, with shape watched, ``SettleRule()``), from
+    its final.restart, or from ``out``'s newer restart file where an earlier call was cut
+    off. Every rank of COMM_WORLD calls this."""
     from mpi4py import MPI
 
     from jkrdt.session import Session
 
     comm = MPI.COMM_WORLD
-    rule = SettleRule(window=WATCH_ONLY, cap_tc=cap_tc)
+    rule = SettleRule(cap_tc=cap_tc) if shape else SettleRule(window=WATCH_ONLY, cap_tc=cap_tc)
     end = rule.cap_steps(rundir.read(run).time_step()[0])
     point = None
     if comm.rank == 0:
+        if shape and "stretch ${settle_stretch}" not in rundir.deck(run).read_text():
+            rundir.write_deck(run)     # a deck from before the keyword: the same but for it
         out.mkdir(parents=True, exist_ok=True)
         shutil.copy2(run / rundir.META, out / rundir.META)    # resume_point looks for it
         point = rundir.resume_point(out, end) if (out / rundir.LOG).exists() else None
@@ -181,6 +185,7 @@ def offsets(records: Path, kept: Path, campaigns: str, cap_tc: float) -> list[di
         t = [r["time"] * 1e6 for r in checks]
         f = [r["growth_efficiency"] for r in checks]
         at = next((k for k, x in enumerate(t) if x >= fixed_us * (1 - 1e-9)), len(t) - 1)
+        reaches = t[-1] >= fixed_us * (1 - 1e-9)
         out.append(dict(record=str(where), B_off=o["B_off"], B_off2=round(o["B_off"] ** 2, 4),
                         seed=o["seed"], model=o["model"], tvis=o["tvis"], v_col=o["v_col"],
                         N_tar=o["N_tar"], stop_reason=o["stop_reason"], end_us=end_us,
@@ -188,7 +193,9 @@ def offsets(records: Path, kept: Path, campaigns: str, cap_tc: float) -> list[di
                         r_g_change_at_end=shape and shape["r_g_growth"],
                         continued=more.exists(),
                         fixed_us=fixed_us, fixed_end_us=t[at], f_gro_fixed_end=f[at],
-                        reaches_fixed_end=t[-1] >= fixed_us * (1 - 1e-9),
+                        reaches_fixed_end=reaches,
+                        # continued with shape watched (--shape), settled before the end
+                        shape_end=more.exists() and not reaches and t[-1] > end_us + 1e-9,
                         time_us=t, f_gro=f))
     return out
 
@@ -220,19 +227,23 @@ def figure(rows: list[dict], results: Path, cap_us: float, title: str,
         ax.plot(r["time_us"], r["f_gro"], color=color, ls=style, lw=1.2, label=label)
         if r["continued"]:
             ax.plot([r["end_us"]], [r["f_gro_end"]], "o", color=color, ms=5, mfc="none")
+        if r["shape_end"]:
+            ax.plot([r["time_us"][-1]], [r["f_gro"][-1]], "s", color=color, ms=5)
     ax.axvline(cap_us, color="0.5", ls=":", lw=1)
     ax.text(cap_us, 1.0, "fixed end ", fontsize=7, va="top", ha="right", color="0.4")
     ax.set_xlim(0, cap_us * 1.02)
     for t in SNAPSHOTS_US:
         ax.axvline(t, color="0.9", lw=0.8, zorder=0)
     ax.axhline(0, color="0.7", lw=0.8)
-    ax.set_xlabel("time (us); grey: the paper's snapshots, circle: where the settle rule "
-                  "ended the run", fontsize=8)
+    ax.set_xlabel("time (us); grey: the paper's snapshots; circle: where the settle rule "
+                  "ended the run" + ("; square: settled with shape watched"
+                                     if any(r["shape_end"] for r in rows) else ""), fontsize=8)
     ax.set_ylabel("f_gro = (N_lar - N_tar) / N_pro")
     ax.set_ylim(-1.05, 1.05)
     ax.legend(fontsize=7, ncol=2, loc="lower left")
-    ax.set_title(f"{title}: f_gro against time, settled runs continued to the fixed end",
-                 fontsize=9)
+    ax.set_title(f"{title}: f_gro against time, settled runs continued to the fixed end"
+                 + ("\nor until settled with shape watched" if any(r["shape_end"] for r in rows)
+                    else ""), fontsize=9)
     fig.tight_layout()
     return save(fig, results, "fig_fixed_end" + tag)
 
@@ -243,7 +254,9 @@ def table(rows: list[dict], done: dict) -> list[str]:
              f"{done['cap_tc']:g} t_c"]
     for r in sorted(rows, key=lambda r: r["B_off2"]):
         fixed = (f"{r['f_gro_fixed_end']:+.3f}" + ("" if r["continued"] or r["stop_reason"]
-                                                   != "settled" else " (not continued)"))
+                                                   != "settled" else " (not continued)")
+                 + (f" (settled with shape watched at {r['fixed_end_us']:.2f} us)"
+                    if r["shape_end"] else ""))
         stretch = ("      -" if r["r_g_change_at_end"] is None
                    else f"{100 * r['r_g_change_at_end']:+6.2f} %")
         lines.append(f"  {protocol.twelfths(r['B_off2'], 1e-3):7s}  {r['stop_reason']:8s} "
@@ -289,6 +302,12 @@ def main(argv=None) -> int:
     p.add_argument("--protocol-runs", type=Path, default=HERE / "runs" / "paper_protocol")
     p.add_argument("--protocol-records", type=Path,
                    default=HERE / "paper_protocol" / "records")
+    p.add_argument("--shape", action="store_true",
+                   help="continue under the settle rule with shape watched (the default "
+                        "rule, SettleRule()) instead of to the fixed end: a run ends where "
+                        "its largest body has stopped stretching and its counts hold, or at "
+                        "the fixed end (validation/end_rule.py measured that end against "
+                        "the fixed end on every run continued there)")
     p.add_argument("--summary-only", action="store_true")
     p.add_argument("--one", nargs=2, type=Path, help=argparse.SUPPRESS)
     args = p.parse_args(argv)
@@ -297,7 +316,7 @@ def main(argv=None) -> int:
         if getattr(args, name) is None:
             setattr(args, name, quick if args.quick else paper)
     if args.one:                                 # one continuation, under mpirun
-        continue_run(args.one[0], args.one[1], args.cap)
+        continue_run(args.one[0], args.one[1], args.cap, args.shape)
         return 0
     runs, results = study_paths(args, "fixed_end")
     kept = results / "records"
@@ -318,7 +337,7 @@ def main(argv=None) -> int:
                       "checks", flush=True)
                 continue
             cmd = [str(BIN / "python"), __file__, "--one", str(run), str(runs / where),
-                   "--cap", str(args.cap)]
+                   "--cap", str(args.cap)] + (["--shape"] if args.shape else [])
             if args.np > 1:
                 cmd = [str(BIN / "mpirun"), "-np", str(args.np)] + cmd
             print(f"{where}: continued to {args.cap:g} t_c", flush=True)
