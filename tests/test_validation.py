@@ -655,6 +655,21 @@ def test_the_fixed_end_study_continues_settled_runs_as_the_same_collision(tmp_pa
         every = before[-1]["step"] - before[-2]["step"]
         assert [c["step"] for c in more][-1] == before[-1]["step"] + every
         assert row["f_gro_fixed_end"] == row["f_gro_end"]
+    # and the study without --shape takes each such continuation on to the fixed end from
+    # where it settled, its record extended: the same rows, then on, a check apart
+    shaped_rows = {r: read_csv(shaped / "records" / r / "checks.csv")
+                   for r in (x["record"] for x in json.loads(
+                       (shaped / "summary.json").read_text())["results"]["offsets"])}
+    run_quick("fixed_end", tmp_path / "shaped", "--np", "2",
+              "--protocol-runs", str(tmp_path / "protocol" / "runs"),
+              "--protocol-records", str(protocol_results / "records"))
+    for row in json.loads((shaped / "summary.json").read_text())["results"]["offsets"]:
+        assert row["reaches_fixed_end"] and not row["shape_end"]
+        more = read_csv(shaped / "records" / row["record"] / "checks.csv")
+        first = shaped_rows[row["record"]]
+        assert more[:len(first)] == first and len(more) > len(first)
+        steps = [c["step"] for c in more]
+        assert len(set(np.diff(steps))) == 1
     # a settled run whose continuation is not kept and whose run directory is gone (a lost
     # machine) is named, with the command that runs it anew; a run made anew that is not
     # the recorded collision (here its record altered) is not continued onto that record

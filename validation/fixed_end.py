@@ -10,7 +10,9 @@ final.restart to that time with the settle checks written but the rule off, so t
 f_gro is read at one fixed end for every offset (a run that hit the cap is there already).
 
     ./run validate fixed_end                 # continue each settled run (hours; resumable)
-    ./run validate fixed_end --shape         # ... until it settles with shape watched
+    ./run validate fixed_end --shape         # ... until it settles with shape watched;
+                                             # a later call without --shape goes on from
+                                             # there to the fixed end, the record extended
     ./run validate fixed_end --summary-only  # the results from the records kept so far
 
 Continuations run one at a time over --np ranks, in the protocol's order of offsets
@@ -78,7 +80,11 @@ def continue_run(run: Path, out: Path, cap_tc: float, shape: bool = False) -> No
             rundir.write_deck(run)     # a deck from before the keyword: the same but for it
         out.mkdir(parents=True, exist_ok=True)
         shutil.copy2(run / rundir.META, out / rundir.META)    # resume_point looks for it
-        point = rundir.resume_point(out, end) if (out / rundir.LOG).exists() else None
+        settled = None if shape else shape_end_step(out)
+        if settled is not None:     # it settled with shape watched: on from there
+            point = (out / rundir.FINAL_RESTART, settled)
+        elif (out / rundir.LOG).exists():
+            point = rundir.resume_point(out, end)
         if point is not None:
             rundir.cut_back(out, point[1])
         else:                       # cut off before its first restart file: anew
@@ -93,6 +99,18 @@ def continue_run(run: Path, out: Path, cap_tc: float, shape: bool = False) -> No
                  variables=dict(steps=end - start)) as s:
         s.run_until_settled(progress=False)
         s.finish()
+
+
+def shape_end_step(out: Path) -> int | None:
+    """The step at which the continuation in ``out`` settled with shape watched (``--shape``),
+    its final.restart at hand, so that it can go on to the fixed end; None otherwise."""
+    if not (out / rundir.FINAL_RESTART).exists() or not (out / rundir.LOG).exists():
+        return None
+    ends = [line for line in (out / rundir.LOG).read_text(errors="replace").splitlines()
+            if line.startswith(rundir.SETTLE_LINE)]
+    if not ends or " settled " not in ends[-1]:
+        return None
+    return int(ends[-1].split(" step ")[1].split()[0])
 
 
 def keep(run: Path, record: Path) -> None:
@@ -325,9 +343,12 @@ def main(argv=None) -> int:
         for run in to_continue(args.protocol_runs, campaigns, args.cap, args.twelfths,
                                args.seeds):
             where = run.relative_to(args.protocol_runs)
-            if (kept / where / rundir.CHECKS).exists():
+            # a continuation that settled with shape watched goes on to the fixed end
+            # (its record extended), unless --shape asks for that end again
+            on = not args.shape and shape_end_step(runs / where) is not None
+            if (kept / where / rundir.CHECKS).exists() and not on:
                 continue
-            if (runs / where / rundir.FINAL_RESTART).exists():     # ended, not yet kept
+            if (runs / where / rundir.FINAL_RESTART).exists() and not on:    # ended, not kept
                 keep(runs / where, kept / where)
                 continue
             differs = not_the_record(run, args.protocol_records / where)
