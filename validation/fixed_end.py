@@ -104,13 +104,10 @@ def continue_run(run: Path, out: Path, cap_tc: float, shape: bool = False) -> No
 def shape_end_step(out: Path) -> int | None:
     """The step at which the continuation in ``out`` settled with shape watched (``--shape``),
     its final.restart at hand, so that it can go on to the fixed end; None otherwise."""
-    if not (out / rundir.FINAL_RESTART).exists() or not (out / rundir.LOG).exists():
+    if not (out / rundir.FINAL_RESTART).exists():
         return None
-    ends = [line for line in (out / rundir.LOG).read_text(errors="replace").splitlines()
-            if line.startswith(rundir.SETTLE_LINE)]
-    if not ends or " settled " not in ends[-1]:
-        return None
-    return int(ends[-1].split(" step ")[1].split()[0])
+    status = rundir.run_status(out)
+    return status.stop_step if status.stop_reason == "settled" else None
 
 
 def keep(run: Path, record: Path) -> None:

@@ -29,12 +29,12 @@ paper's 2 x 50000 where the placement says it decides something (``--stage paper
 (``RUNS/n<N>_<question>_b2_<B_off^2>``), in the order of QUESTIONS; a second call resumes
 them, and a campaign whose runs all have their records kept is not run again, on this
 machine or a new one (``--again K`` runs the offset K/12 anew, bit for bit on the same
-build and ranks, for ``fixed_end`` to continue). Every run ends by the settle rule, its dt chosen by ``--dt auto`` for max |dE| /
-E_imp <= 1e-3 (vfra_size.TOLERANCE); at the paper's size a run that has not settled by
-PAPER_CAP_TC ends there and is averaged at its end (``summary.json``'s ``ended_at_cap``
-lists each with how far its f_gro moved over its last 1.6 us; ``end_rule.py`` measures
-the cap against the runs' real ends), and a run that failed or was cut off is left out
-(``left_out``).
+build and ranks, for ``fixed_end`` to continue). Every run ends by the settle rule, its
+dt chosen by ``--dt auto`` for max |dE| / E_imp <= 1e-3 (vfra_size.TOLERANCE); at the
+paper's size a run that has not settled by PAPER_CAP_TC ends there and is averaged at
+its end (``summary.json``'s ``ended_at_cap`` lists each with how far its f_gro moved over
+its last 1.6 us; ``end_rule.py`` measures the cap against the runs' real ends), and a run
+that failed or was cut off is left out (``left_out``).
 
 The small record of every finished run (``jkrdt.rundir.RECORD``: outcome.json,
 checks.csv, collision.json, frames.csv, the outcome and timeline pictures) is copied to
@@ -110,6 +110,8 @@ def model_name(outcome: dict) -> str:
     """The MODELS name of a run's model, from its outcome (its kind and T_vis)."""
     return next(name for name, (kind, tvis, _) in MODELS.items()
                 if kind == outcome["model"] and tvis == (outcome.get("tvis") or 0.0))
+
+
 #: the paper stage's cap, t_c (4.4 us for 0.1 um ice): a run that has not settled by then
 #: ends there and is counted at its end, as the paper's runs end at a time it does not
 #: state. Twice the latest any paper-size run settled (8302 t_c, b at 6/12) and 2.7 times
