@@ -384,7 +384,14 @@ def test_the_paper_protocol_study_averages_twelve_offsets_and_keeps_every_record
     run_quick("paper_protocol", tmp_path, "--summary-only")
     done = json.loads((results / "summary.json").read_text())
     assert len(read_csv(results / "runs.csv")) == len(runs)
-    assert done["results"] == json.loads(before)["results"]
+    # the same results, but that the run is read at its cap, not at its settle end
+    was, now = json.loads(before)["results"], done["results"]
+    question = record.relative_to(results / "records").parts[0].split("_")[1]
+    k, seed = f"{outcome['B_off'] ** 2:.4f}", str(outcome["seed"])
+    read = now["by_question"][question]["24"]["read"]["per_seed"][k][seed]
+    assert read["read_at"] == "cap" and read["f_gro"] == outcome["growth_efficiency"]
+    was["by_question"][question]["24"]["read"]["per_seed"][k][seed]["read_at"] = "cap"
+    assert now == was
     [cap] = done["ended_at_cap"]
     assert cap["seed"] == outcome["seed"] and done["left_out"] == []
     assert cap["B_off2"] == pytest.approx(outcome["B_off"] ** 2, abs=1e-4)
@@ -641,6 +648,19 @@ def test_the_fixed_end_study_continues_settled_runs_as_the_same_collision(tmp_pa
         assert 1200 * t_c <= more[-1]["time"] < 1200 * t_c + every * meta["dt_over_tc"] * t_c
         assert r["fixed_end_us"] == pytest.approx(more[-1]["time"] * 1e6, rel=1e-12)
         assert r["f_gro_fixed_end"] == (more[-1]["n_largest"] - 24) / 24
+    # the protocol's summary reads each run where its continuation ended: here at the
+    # fixed end, f_gro that of the continuation's last check
+    def read_by_protocol(continued):
+        run_quick("paper_protocol", tmp_path / "protocol", "--summary-only",
+                  "--continued", str(continued))
+        s = json.loads((protocol_results / "summary.json").read_text())
+        return s["results"]["by_question"]["a"]["24"]["read"]["per_seed"]["0.0000"]
+
+    read = read_by_protocol(results / "records")
+    for r in rows:
+        assert read[str(r["seed"])]["read_at"] == "fixed end"
+        assert read[str(r["seed"])]["f_gro"] == r["f_gro_fixed_end"]
+        assert read[str(r["seed"])]["time_us"] == r["fixed_end_us"]
     # --shape continues a run under the settle rule with shape watched instead: these
     # shattered runs (a largest fragment of a few grains, below a quarter of the 48, so
     # shape is not watched) stay settled, so each continuation settles at its first check,
@@ -655,6 +675,11 @@ def test_the_fixed_end_study_continues_settled_runs_as_the_same_collision(tmp_pa
         every = before[-1]["step"] - before[-2]["step"]
         assert [c["step"] for c in more][-1] == before[-1]["step"] + every
         assert row["f_gro_fixed_end"] == row["f_gro_end"]
+    # read there by the protocol's summary: at the shape end, one check on
+    read = read_by_protocol(shaped / "records")
+    for row in json.loads((shaped / "summary.json").read_text())["results"]["offsets"]:
+        assert read[str(row["seed"])]["read_at"] == "shape end"
+        assert read[str(row["seed"])]["time_us"] == row["fixed_end_us"]
     # and the study without --shape takes each such continuation on to the fixed end from
     # where it settled, its record extended: the same rows, then on, a check apart
     shaped_rows = {r: read_csv(shaped / "records" / r / "checks.csv")
@@ -693,6 +718,39 @@ def test_the_fixed_end_study_continues_settled_runs_as_the_same_collision(tmp_pa
     assert [m["record"] for m in summary["not_at_hand"]] == [first["record"]]
     assert summary["not_at_hand"][0]["twelfths"] == 0
     assert "--questions a --again 0" in said
+
+
+def test_each_paper_size_record_is_read_where_its_outcome_is_decided():
+    # validation/readings.py on the committed records of question b at 2 x 50000: 1/12
+    # settled with its body stretching (r_g +4.2 % over the rule's window) and was
+    # continued, so it is read at the fixed end, 16000 t_c, from its continuation's check
+    # there; 3/12 settled stretching (+2.3 %, above the rule's 1 % tolerance) and its
+    # continuation was lost, so it is open, no f_gro; 4/12 grew +0.96 %, within the
+    # tolerance, so the rule with shape watched ends it where it ended, its f_gro the record's
+    sys.path.insert(0, str(ROOT / "validation"))
+    from paper_protocol import PAPER_CAP_TC
+    from readings import read
+
+    records = ROOT / "validation" / "paper_protocol" / "records"
+    kept = ROOT / "validation" / "fixed_end" / "records"
+
+    def reading(k):
+        where = Path(f"n50000_b_b2_{k / 12:.4f}") / "v39.8" / f"b2_{k / 12:.4f}" / "seed1"
+        o = json.loads((records / where / "outcome.json").read_text())
+        return o, read(o, records / where, kept / where, PAPER_CAP_TC), kept / where
+
+    from jkrdt import rundir
+
+    o, r, more = reading(1)
+    fixed = PAPER_CAP_TC * rundir.read(more).scales.t_c     # 4.4 us
+    at = next(c for c in read_csv(more / "checks.csv") if c["time"] >= fixed * (1 - 1e-9))
+    assert r["read_at"] == "fixed end" and o["growth_efficiency"] > 0.8
+    assert r["f_gro"] == pytest.approx((at["n_largest"] - 50000) / 50000, abs=1e-12)
+    assert r["f_gro"] == pytest.approx(-0.272, abs=1e-3)
+    o, r, _ = reading(3)
+    assert r["read_at"] == "open" and r["f_gro"] is None
+    o, r, _ = reading(4)
+    assert r["read_at"] == "settle end" and r["f_gro"] == o["growth_efficiency"]
 
 
 def test_a_stopped_campaign_keeps_the_records_of_the_runs_it_finished(tmp_path):

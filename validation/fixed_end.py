@@ -44,20 +44,18 @@ from pathlib import Path
 
 from common import BIN, campaign_study_parser, save, study_paths, write_summary
 from jkrdt import protocol, rundir
-from jkrdt.analysis.outcome import from_checks, stretching
+from jkrdt.analysis.outcome import stretching
 from jkrdt.analysis.summary import b_off_average, b_off_groups
-from jkrdt.analysis.tables import read_csv
 from jkrdt.stopping import SettleRule
-from paper_protocol import (PAPER_CAP_TC, QUESTIONS, SNAPSHOTS_US, TWELFTHS_FIRST,
-                            what_the_rest_needs)
+from paper_protocol import (PAPER_CAP_TC, QUESTIONS, QUICK_CAP_TC, SNAPSHOTS_US,
+                            TWELFTHS_FIRST, what_the_rest_needs)
+from readings import checks_through
 
 HERE = Path(__file__).resolve().parent
 #: a settle window no run reaches: the checks are written, the rule never ends the run
 WATCH_ONLY = 10 ** 9
 #: the settle rule the runs ended with (its window and tolerance)
 SETTLE = SettleRule()
-#: the quick variant's fixed end (t_c): its head-on 2 x 24 runs settle by about 400 t_c
-QUICK_CAP_TC = 1200.0
 #: what each continued run's record holds
 KEPT = (rundir.CHECKS, rundir.META)
 
@@ -189,14 +187,12 @@ def offsets(records: Path, kept: Path, campaigns: str, cap_tc: float) -> list[di
     for outcome in sorted(records.glob(f"{campaigns}/v*/b2_*/seed*/{rundir.OUTCOME}")):
         o = json.loads(outcome.read_text())
         where = outcome.parent.relative_to(records)
-        checks = from_checks(read_csv(outcome.parent / rundir.CHECKS), o["N_tar"], o["N_pro"])
+        checks = checks_through(outcome.parent, None, o["N_tar"], o["N_pro"])
         end_us = checks[-1]["time"] * 1e6
         fixed_us = cap_tc * rundir.read(outcome.parent).scales.t_c * 1e6
         shape = stretching(checks, SETTLE.window, SETTLE.tolerance)     # None: one grain
         more = kept / where / rundir.CHECKS
-        if more.exists():
-            checks += [r for r in from_checks(read_csv(more), o["N_tar"], o["N_pro"])
-                       if r["step"] > checks[-1]["step"]]
+        checks = checks_through(outcome.parent, kept / where, o["N_tar"], o["N_pro"])
         t = [r["time"] * 1e6 for r in checks]
         f = [r["growth_efficiency"] for r in checks]
         at = next((k for k, x in enumerate(t) if x >= fixed_us * (1 - 1e-9)), len(t) - 1)

@@ -45,6 +45,9 @@ per offset and seed, <f_gro> by eq. 1 with its seed scatter where the twelve off
 the diagnostics' eq. 1 means, and f_gro at the paper's snapshot times 0.4-1.6 us read
 from each run's settle checks, to show whether where a run ends moves it; the paper's
 statements of App. C against the runs, one row each) and fig_protocol (f_gro, N_con / N_tot and N_cut / N_tot against B_off^2).
+Each run is also read where its outcome is decided (``readings.py``; its continuation's
+record from ``fixed_end``, ``--continued``): summary.json's ``read`` per question and
+size, with eq. (1)'s <f_gro> so read, or what the offsets not yet read must average.
 
     ./run validate paper_protocol                   # --stage place: 2 x 5000, hours
     ./run validate paper_protocol --questions a c
@@ -63,7 +66,7 @@ from pathlib import Path
 import numpy as np
 
 from bpca3d_models import MODELS, model_spec
-from common import (all_kept, campaign_study_parser, run_campaigns, save, study_paths,
+from common import (HERE, all_kept, campaign_study_parser, run_campaigns, save, study_paths,
                     write_summary)
 from jkrdt import protocol, rundir
 from jkrdt.analysis.outcome import from_checks
@@ -71,6 +74,7 @@ from jkrdt.analysis.summary import (b_off_average, b_off_groups, mean_diagnostic
                                    seed_scatter)
 from jkrdt.analysis.tables import read_csv, write_csv
 from jkrdt.stopping import COMPLETE
+from readings import OPEN, read
 from vfra_size import TOLERANCE
 
 #: the paper's twelve offsets in the order they are run where they decide a sign: the two
@@ -119,6 +123,9 @@ def model_name(outcome: dict) -> str:
 #: check for microseconds after the outcome is fixed (b at 9/12), which the settle rule's
 #: counts (10 grains) never let settle. Measured against the runs' real ends: end_rule.py
 PAPER_CAP_TC = 16000.0
+#: the quick variant's fixed end (t_c), to which ``fixed_end --quick`` continues its runs:
+#: the quick head-on 2 x 24 runs settle by about 400 t_c
+QUICK_CAP_TC = 1200.0
 #: the paper-size campaigns started with the default cap (SettleRule.cap_tc) before the
 #: paper stage's was lowered: they keep it, so that they resume (or run again, --again)
 #: under the spec they began. 9/12 began so too, but its run directory was lost with its
@@ -219,14 +226,21 @@ def f_gro_range_before_end(record: Path, n_tar: int, n_pro: int) -> list[float]:
     return [min(f), max(f)]
 
 
-def load(records: Path) -> list[dict]:
-    """Every kept record's outcome, with its size, question and f_gro at SNAPSHOTS_US."""
+def load(records: Path, continued: Path | None = None,
+         fixed_tc: float = PAPER_CAP_TC) -> list[dict]:
+    """Every kept record's outcome, with its size, question, f_gro at SNAPSHOTS_US and,
+    for a run that ended as this study counts it, where its outcome is read
+    (``readings.read``: ``continued`` holds the continuations' records, ``fixed_end``'s,
+    made to the fixed end ``fixed_tc``)."""
     out = []
     for path in sorted(records.rglob(rundir.OUTCOME)):
         o = json.loads(path.read_text())
         o["n"], o["question"] = question_of(path.parent, records)
         o["f_gro_at_us"] = f_gro_at(path.parent, o["N_tar"], o["N_pro"])
         o["record"] = path.parent
+        if o.get("stop_reason") in COUNTED:
+            where = path.parent.relative_to(records)
+            o["read"] = read(o, path.parent, continued and continued / where, fixed_tc)
         out.append(o)
     return out
 
@@ -274,12 +288,38 @@ def question_summary(runs: list[dict], twelve: bool) -> dict:
     out["f_gro_at_us"] = {t: [float(x) for x in f] for t, f in at.items()}
     if twelve:
         out["sign_open"] = what_the_rest_needs(b2, f)
+    out["read"] = read_summary(runs, twelve)
     if out["paper_grid"]:
         out["mean_f_gro"] = seed_scatter(runs, f_gro, protocol.GRAZING["growth_efficiency"])
         out["means"] = mean_diagnostics(runs)
         out["mean_f_gro_at_us"] = {
             t: seed_scatter(runs, lambda o: o["f_gro_at_us"][t],
                             protocol.GRAZING["growth_efficiency"])["mean"] for t in at}
+    return out
+
+
+def read_summary(runs: list[dict], twelve: bool) -> dict:
+    """The question's runs as ``readings.read`` reads them: per offset and seed, f_gro, the
+    end it is read at and when; f_gro per offset (seeds averaged over the runs read, an
+    offset whose every run is open left out); and eq. (1)'s <f_gro> with its seed scatter
+    where the twelve offsets are read, else (``twelve``) what the offsets not read yet
+    must average for <f_gro> < 0."""
+    per_seed = defaultdict(dict)
+    for o in runs:
+        per_seed[f"{o['B_off'] ** 2:.4f}"][o["seed"]] = o["read"]
+    known = [o for o in runs if o["read"]["read_at"] != OPEN]
+    out = dict(per_seed=dict(per_seed),
+               open=sorted({round(o["B_off"] ** 2, 4) for o in runs} -
+                           {round(o["B_off"] ** 2, 4) for o in known}))
+    if not known:
+        return out
+    f_read = lambda o: o["read"]["f_gro"]    # noqa: E731
+    b2, f = b_off_groups(known, f_read)
+    out.update(B_off2=[float(b) for b in b2], f_gro=[float(x) for x in f])
+    if twelve:
+        out["sign_open"] = what_the_rest_needs(b2, f)
+    if protocol.is_paper_grid(b2):
+        out["mean_f_gro"] = seed_scatter(known, f_read, protocol.GRAZING["growth_efficiency"])
     return out
 
 
@@ -475,7 +515,17 @@ def figure(summary: dict, results: Path) -> list[Path]:
         ax = axes[0, col]
         for b, by_seed in s["f_gro_per_seed"].items():
             ax.plot([float(b)] * len(by_seed), list(by_seed.values()), "o", color="0.6", ms=4)
-        ax.plot(s["B_off2"], s["f_gro"], "k-o", ms=4, label="seeds averaged")
+        ax.plot(s["B_off2"], s["f_gro"], "k-o", ms=4, label="seeds averaged, where they ended")
+        r = s["read"]
+        if r.get("B_off2") and r["f_gro"] != [f for b, f in zip(s["B_off2"], s["f_gro"])
+                                              if b in r["B_off2"]]:
+            ax.plot(r["B_off2"], r["f_gro"], "s", color="C3", mfc="none", ms=7,
+                    label="read where decided (readings.py)")
+            if r.get("mean_f_gro"):
+                ax.axhline(r["mean_f_gro"]["mean"], color="C3", ls=":",
+                           label=f"<f_gro> so read {r['mean_f_gro']['mean']:+.3f}")
+            for b in r["open"]:
+                ax.annotate("open", (b, -0.95), fontsize=6, ha="center", color="C3")
         if s.get("mean_f_gro"):
             ax.plot([1.0], [protocol.GRAZING["growth_efficiency"]], "o", mfc="none",
                     color="k", ms=5, label="12/12 grazes: taken as 0")
@@ -533,15 +583,17 @@ def cell(outcome: dict):
     return f"{outcome['N_tar']}, {model_name(outcome)}"
 
 
-def summarise(records: Path, results: Path, plot: bool = True) -> dict:
-    loaded = load(records)
+def summarise(records: Path, results: Path, plot: bool = True,
+              continued: Path | None = None, fixed_tc: float = PAPER_CAP_TC) -> dict:
+    loaded = load(records, continued, fixed_tc)
     outcomes = [o for o in loaded if o.get("stop_reason") in COUNTED]
     rows = []
     for o in outcomes:
         r = scalars(o)
         r.update(time_end_over_tc=o.get("time_end_over_tc"),
                  **{f"f_gro_at_{t}_us": f for t, f in o["f_gro_at_us"].items()})
-        r.update(question=o["question"], model_name=model_name(o))
+        r.update(question=o["question"], model_name=model_name(o), read_at=o["read"]["read_at"],
+                 f_gro_read=o["read"]["f_gro"], read_time_us=o["read"]["time_us"])
         rows.append(r)
     write_csv(results / "runs.csv", [{k: v for k, v in r.items() if k != "run"} for r in rows])
     by = defaultdict(lambda: defaultdict(list))
@@ -584,14 +636,31 @@ def table(by_question: dict) -> list[str]:
                 f = "  ".join(f"{v:+.3f} ({seed})" for seed, v in sorted(seeds.items()))
                 lines.append(f"  {protocol.twelfths(b, 1e-3) or f'{b:.4f}':7s}  {f:22s} "
                              f"{con:11.2f}  {cut:11.2f}")
-            if s.get("mean_f_gro"):
-                m = s["mean_f_gro"]
-                lines.append(f"  <f_gro> (eq. 1) {m['mean']:+.3f} +- {m['se']:.3f}")
-            elif s.get("sign_open"):
-                o = s["sign_open"]
-                lines.append(f"  to run: {' '.join(o['to_run'])}; <f_gro> < 0 needs them to "
-                             f"average below {o['rest_must_average_below']:+.3f}")
+            lines += mean_lines(s, "where each run ended")
+            r = s["read"]
+            if any(x["read_at"] != "settle end" for seeds in r["per_seed"].values()
+                   for x in seeds.values()):
+                lines.append("  read where its outcome is decided (readings.py):")
+                for b, seeds in sorted(r["per_seed"].items()):
+                    f = "  ".join(("open" if x["f_gro"] is None else f"{x['f_gro']:+.3f}")
+                                  + f" ({seed}: {x['read_at']}, {x['time_us']:.2f} us)"
+                                  for seed, x in sorted(seeds.items()))
+                    lines.append(f"  {protocol.twelfths(float(b), 1e-3) or b:7s}  {f}")
+                lines += mean_lines(r, "so read")
     return lines
+
+
+def mean_lines(s: dict, how: str) -> list[str]:
+    """eq. (1)'s <f_gro> of a summary (``question_summary`` or its ``read``), or what the
+    offsets still to run or read must average for it to be negative."""
+    if s.get("mean_f_gro"):
+        m = s["mean_f_gro"]
+        return [f"  <f_gro> (eq. 1), {how}: {m['mean']:+.3f} +- {m['se']:.3f}"]
+    if s.get("sign_open"):
+        o = s["sign_open"]
+        return [f"  {how}: {' '.join(o['to_run'])} to come; <f_gro> < 0 needs them to "
+                f"average below {o['rest_must_average_below']:+.3f}"]
+    return []
 
 
 def main(argv=None) -> int:
@@ -603,14 +672,21 @@ def main(argv=None) -> int:
     p.add_argument("--again", type=int, nargs="+", default=(), metavar="K",
                    help="run the offsets B_off^2 = K/12 again though their records are kept "
                         "(for fixed_end, which continues a run from its run directory)")
+    p.add_argument("--continued", type=Path, default=None,
+                   help="the records of the runs' continuations, where each run is read "
+                        "(default: fixed_end's, validation/fixed_end[_quick]/records, "
+                        "unless --results is given)")
     args = p.parse_args(argv)
     runs, results = study_paths(args, "paper_protocol")
     records = results / "records"
+    continued = args.continued or (None if args.results else
+                                   HERE / ("fixed_end" + "_quick" * args.quick) / "records")
     stage = QUICK if args.quick else STAGES[args.stage]
     if not args.summary_only:
         for k in args.questions or list(QUESTIONS):
             run_question(k, stage, runs, args.np, tuple(args.again))
-    done = summarise(records, results)
+    done = summarise(records, results, continued=continued,
+                     fixed_tc=QUICK_CAP_TC if args.quick else PAPER_CAP_TC)
     print("\n".join(table(done["results"]["by_question"])))
     for o in done["ended_at_cap"]:
         low, high = o["f_gro_last_span"]

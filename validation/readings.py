@@ -1,0 +1,68 @@
+"""Where a kept run's outcome is read: the end that decides its f_gro (issue 46).
+
+At 2 x 50000 the settle rule as it was (shape not watched, ``stretch 0``) ended runs while
+a neck still held their largest body, which parted later (``fixed_end``). A run's record
+therefore gives its f_gro where it ended, and that is its outcome only if its body was
+not stretching there. Each kept record is read, in this order, at:
+
+  fixed end   its continuation (``fixed_end``'s record) reached the fixed end
+  shape end   its continuation settled with shape watched (``fixed_end --shape``)
+  cap         it ended at its stage's cap, and is counted there (``paper_protocol``)
+  settle end  it settled with its largest body not stretching over the rule's last window
+              (``analysis.outcome.stretching``): the rule with shape watched ends it at the
+              same check, so it reads the same f_gro whether or not it watched shape
+  open        it settled while its largest body was stretching and was not continued:
+              its outcome is not known, and it is left out of every reading's average
+
+The f_gro of each is (N_lar - N_tar) / N_pro at that check of the run's settle checks.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from jkrdt import rundir
+from jkrdt.analysis.outcome import from_checks, stretching
+from jkrdt.analysis.tables import read_csv
+from jkrdt.stopping import SettleRule
+
+#: the settle rule's window and tolerance, over which a largest body's stretching is judged
+RULE = SettleRule()
+
+#: how a record can be read, in the order above; OPEN is not a reading
+FIXED_END, SHAPE_END, CAP, SETTLE_END, OPEN = ("fixed end", "shape end", "cap",
+                                               "settle end", "open")
+
+
+def checks_through(record: Path, continued: Path | None, n_tar: int, n_pro: int) -> list[dict]:
+    """The settle checks of the run of ``record`` (rows of ``from_checks``), with those of
+    its continuation's record ``continued`` after its end appended where one is kept."""
+    rows = from_checks(read_csv(record / rundir.CHECKS), n_tar, n_pro)
+    more = continued / rundir.CHECKS if continued is not None else None
+    if more is not None and more.exists():
+        rows += [r for r in from_checks(read_csv(more), n_tar, n_pro)
+                 if r["step"] > rows[-1]["step"]]
+    return rows
+
+
+def read(outcome: dict, record: Path, continued: Path | None, cap_tc: float) -> dict:
+    """How the run of ``record`` (its ``outcome``) is read: ``read_at`` (one of the five
+    above), ``f_gro`` there (None where open) and the time there, ``time_us``. Its
+    continuation's record is ``continued`` (None or absent: not continued); ``cap_tc``
+    is the fixed end it was continued to."""
+    end = dict(f_gro=outcome["growth_efficiency"], time_us=outcome["time_end"] * 1e6)
+    if continued is not None and (continued / rundir.CHECKS).exists():
+        rows = checks_through(record, continued, outcome["N_tar"], outcome["N_pro"])
+        fixed_us = cap_tc * rundir.read(record).scales.t_c * 1e6
+        # the first check at or after the fixed end, as a cap ends a run
+        at = next((r for r in rows if r["time"] * 1e6 >= fixed_us * (1 - 1e-9)), None)
+        last = at or rows[-1]
+        return dict(read_at=FIXED_END if at else SHAPE_END, f_gro=last["growth_efficiency"],
+                    time_us=last["time"] * 1e6)
+    if outcome.get("stop_reason") == "cap":
+        return dict(end, read_at=CAP)
+    rows = checks_through(record, None, outcome["N_tar"], outcome["N_pro"])
+    shape = stretching(rows, RULE.window, RULE.tolerance)
+    if shape and shape["stretching"]:
+        return dict(read_at=OPEN, f_gro=None, time_us=end["time_us"])
+    return dict(end, read_at=SETTLE_END)
