@@ -794,6 +794,9 @@ def test_a_stopped_campaign_keeps_the_records_of_the_runs_it_finished(tmp_path):
     assert [p.relative_to(records) for p in kept] == [first.relative_to(runs)]
     assert json.loads(kept[0].read_text()) == json.loads(first.read_text())
     assert not (records / cut.relative_to(runs)).exists()
+    # the settle rule the runs ended by survives with them (readings depend on its stretch)
+    kept_spec = json.loads((records / "c" / "campaign.json").read_text())["spec"]
+    assert kept_spec["settle"]["check_tc"] == 5 and kept_spec["settle"]["stretch"] == 0.25
     subprocess.run([str(Path(sys.executable).parent / "jkrdt"), "analyse", str(cut), "--partial",
                     "--no-plots"], check=True, capture_output=True, timeout=300)
     assert rundir.read_outcome(cut)["stop_reason"] == "cut off"

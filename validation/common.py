@@ -169,12 +169,16 @@ def keep_records(campaign: Path, records: Path) -> list[Path]:
     ``campaign`` (``rundir.finished``: not the partial outcome of a run cut off) to the same
     place below ``records``, so that the study re-analyses and re-plots from the repository
     alone once its run directories are gone. A record is copied whole or not at all (its
-    outcome.json last) and never replaced; returns the records it copied."""
+    outcome.json last) and never replaced; returns the records it copied. The campaign's
+    spec (``jkrdt.campaign.SPEC_RECORD``: the settle rule its runs ended by, among the
+    rest) goes beside its records once, as soon as one is kept."""
     import shutil
 
     from jkrdt import rundir
+    from jkrdt.campaign import SPEC_RECORD
 
     kept = []
+    spec = Path(campaign) / SPEC_RECORD
     for outcome in sorted(Path(campaign).rglob(rundir.OUTCOME)):
         run = outcome.parent
         to = records / run.relative_to(campaign)
@@ -186,6 +190,8 @@ def keep_records(campaign: Path, records: Path) -> list[Path]:
                 shutil.copy2(run / name, to / name)
         shutil.copy2(outcome, to / rundir.OUTCOME)
         kept.append(to)
+    if spec.exists() and records.exists() and not (records / SPEC_RECORD).exists():
+        shutil.copy2(spec, records / SPEC_RECORD)
     return kept
 
 
