@@ -49,13 +49,11 @@ from jkrdt.analysis.summary import b_off_average, b_off_groups
 from jkrdt.stopping import SettleRule
 from paper_protocol import (PAPER_CAP_TC, QUESTIONS, QUICK_CAP_TC, SNAPSHOTS_US,
                             TWELFTHS_FIRST, what_the_rest_needs)
-from readings import checks_through
+from readings import RULE, checks_through, continued_after, first_at, fixed_end_us
 
 HERE = Path(__file__).resolve().parent
 #: a settle window no run reaches: the checks are written, the rule never ends the run
 WATCH_ONLY = 10 ** 9
-#: the settle rule the runs ended with (its window and tolerance)
-SETTLE = SettleRule()
 #: what each continued run's record holds
 KEPT = (rundir.CHECKS, rundir.META)
 
@@ -187,16 +185,17 @@ def offsets(records: Path, kept: Path, campaigns: str, cap_tc: float) -> list[di
     for outcome in sorted(records.glob(f"{campaigns}/v*/b2_*/seed*/{rundir.OUTCOME}")):
         o = json.loads(outcome.read_text())
         where = outcome.parent.relative_to(records)
-        checks = checks_through(outcome.parent, None, o["N_tar"], o["N_pro"])
-        end_us = checks[-1]["time"] * 1e6
-        fixed_us = cap_tc * rundir.read(outcome.parent).scales.t_c * 1e6
-        shape = stretching(checks, SETTLE.window, SETTLE.tolerance)     # None: one grain
+        own = checks_through(outcome.parent, None, o["N_tar"], o["N_pro"])
+        end_us = own[-1]["time"] * 1e6
+        fixed_us = fixed_end_us(outcome.parent, cap_tc)
+        shape = stretching(own, RULE.window, RULE.tolerance)     # None: one grain
         more = kept / where / rundir.CHECKS
-        checks = checks_through(outcome.parent, kept / where, o["N_tar"], o["N_pro"])
+        checks = own + continued_after(own, kept / where, o["N_tar"], o["N_pro"])
         t = [r["time"] * 1e6 for r in checks]
         f = [r["growth_efficiency"] for r in checks]
-        at = next((k for k, x in enumerate(t) if x >= fixed_us * (1 - 1e-9)), len(t) - 1)
-        reaches = t[-1] >= fixed_us * (1 - 1e-9)
+        at = first_at(checks, fixed_us)
+        reaches = at is not None
+        at = len(t) - 1 if at is None else at
         out.append(dict(record=str(where), B_off=o["B_off"], B_off2=round(o["B_off"] ** 2, 4),
                         seed=o["seed"], model=o["model"], tvis=o["tvis"], v_col=o["v_col"],
                         N_tar=o["N_tar"], stop_reason=o["stop_reason"], end_us=end_us,

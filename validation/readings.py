@@ -38,11 +38,28 @@ def checks_through(record: Path, continued: Path | None, n_tar: int, n_pro: int)
     """The settle checks of the run of ``record`` (rows of ``from_checks``), with those of
     its continuation's record ``continued`` after its end appended where one is kept."""
     rows = from_checks(read_csv(record / rundir.CHECKS), n_tar, n_pro)
+    return rows + continued_after(rows, continued, n_tar, n_pro)
+
+
+def continued_after(rows: list[dict], continued: Path | None, n_tar: int,
+                    n_pro: int) -> list[dict]:
+    """The checks of the continuation's record ``continued`` after the last of ``rows``
+    (none where no continuation is kept)."""
     more = continued / rundir.CHECKS if continued is not None else None
-    if more is not None and more.exists():
-        rows += [r for r in from_checks(read_csv(more), n_tar, n_pro)
-                 if r["step"] > rows[-1]["step"]]
-    return rows
+    if more is None or not more.exists():
+        return []
+    return [r for r in from_checks(read_csv(more), n_tar, n_pro) if r["step"] > rows[-1]["step"]]
+
+
+def fixed_end_us(record: Path, cap_tc: float) -> float:
+    """The fixed end ``cap_tc`` (in t_c) of the run of ``record``, in microseconds."""
+    return cap_tc * rundir.read(record).scales.t_c * 1e6
+
+
+def first_at(rows: list[dict], time_us: float) -> int | None:
+    """The first of ``rows`` at or after ``time_us``, as a cap ends a run (None: none)."""
+    return next((k for k, r in enumerate(rows) if r["time"] * 1e6 >= time_us * (1 - 1e-9)),
+                None)
 
 
 def read(outcome: dict, record: Path, continued: Path | None, cap_tc: float) -> dict:
@@ -53,12 +70,10 @@ def read(outcome: dict, record: Path, continued: Path | None, cap_tc: float) -> 
     end = dict(f_gro=outcome["growth_efficiency"], time_us=outcome["time_end"] * 1e6)
     if continued is not None and (continued / rundir.CHECKS).exists():
         rows = checks_through(record, continued, outcome["N_tar"], outcome["N_pro"])
-        fixed_us = cap_tc * rundir.read(record).scales.t_c * 1e6
-        # the first check at or after the fixed end, as a cap ends a run
-        at = next((r for r in rows if r["time"] * 1e6 >= fixed_us * (1 - 1e-9)), None)
-        last = at or rows[-1]
-        return dict(read_at=FIXED_END if at else SHAPE_END, f_gro=last["growth_efficiency"],
-                    time_us=last["time"] * 1e6)
+        at = first_at(rows, fixed_end_us(record, cap_tc))
+        last = rows[-1 if at is None else at]
+        return dict(read_at=SHAPE_END if at is None else FIXED_END,
+                    f_gro=last["growth_efficiency"], time_us=last["time"] * 1e6)
     if outcome.get("stop_reason") == "cap":
         return dict(end, read_at=CAP)
     rows = checks_through(record, None, outcome["N_tar"], outcome["N_pro"])
