@@ -751,6 +751,15 @@ def test_each_paper_size_record_is_read_where_its_outcome_is_decided():
     assert r["read_at"] == "open" and r["f_gro"] is None
     o, r, _ = reading(4)
     assert r["read_at"] == "settle end" and r["f_gro"] == o["growth_efficiency"]
+    # the size trend reads the same records so: 1/12 at its fixed end, 3/12 open, so no
+    # f_near at 2 x 50000; where the settle rule ended them, as they were
+    from size_trend import dissipation_runs, size_rows
+
+    big = size_rows(dissipation_runs(ROOT / "validation" / "size_trend" / "records",
+                                     records))[50000]
+    assert big["per_offset"]["1/12"] == pytest.approx(-0.272, abs=1e-3)
+    assert big["per_offset_settle_end"]["1/12"] > 0.8
+    assert big["open"] == ["3/12"] and big["f_near"] is None
 
 
 def test_a_stopped_campaign_keeps_the_records_of_the_runs_it_finished(tmp_path):

@@ -2,8 +2,9 @@
 
 Issue 46, item 5. Undamped frictionless collisions at 39.8 m/s on the paper's offsets give
 f_gro about -0.96 head-on at 2 x 1000, about 0 at 2 x 5000 and +0.69 at 2 x 50000, and the
-offsets next to head-on turn with it (B_off^2 1/12: -0.47 at 2 x 5000, +0.81 at 2 x 50000);
-the offsets from 4/12 on hardly move (``validation/paper_protocol``). So the candidates are
+offsets next to head-on seemed to turn with it (B_off^2 1/12: -0.47 at 2 x 5000, +0.81 at
+2 x 50000 where the settle rule ended it, -0.27 read at the fixed end, ``readings``); the
+offsets from 4/12 on hardly move (``validation/paper_protocol``). So the candidates are
 tested where the turn is: B_off^2 = 0 ... 3/12, one at a time, each against the same scenes
 (seeds) run the way the paper-size runs were (``base``: dt by ``--dt auto`` for max |dE| /
 E_imp <= 1e-3, bonds at the JKR equilibrium delta_0, a gap of delta_c / 2, the settle rule):
@@ -27,7 +28,8 @@ eq. (1) weights on its grid (1/2, 1, 1, 1), per seed; its part of <f_gro> is 3.5
 Collisions are chaotic, so each candidate is compared with base as ensembles (mean and
 standard error over seeds; ``common.within_scatter``), never run against run. The size
 trend itself is read from the same offsets of ``validation/paper_protocol``'s records
-(2 x 5000 seeds 1, 2; 2 x 50000 seed 1).
+(2 x 5000 seeds 1, 2; 2 x 50000 seed 1), each where its outcome is decided
+(``readings.read``, with ``fixed_end``'s continuations).
 
 The dissipation that makes the difference is read from the records of the frictionless
 base runs and of the paper protocol's: E_dis(t) / E_imp against time in aggregate crossing
@@ -55,7 +57,8 @@ from common import (HERE, campaign_study_parser, mean_se, run_campaigns, save, s
 from jkrdt import rundir
 from jkrdt.analysis.tables import read_csv, write_csv
 from jkrdt.stopping import COMPLETE
-from paper_protocol import SNAPSHOTS_US, f_gro_at
+from paper_protocol import PAPER_CAP_TC, SNAPSHOTS_US, f_gro_at
+from readings import read
 from vfra_size import TOLERANCE
 
 FULL = dict(n=1000, b_off2=[0.0, 1 / 12, 2 / 12, 3 / 12], seeds=[1, 2, 3, 4])
@@ -74,8 +77,10 @@ QUESTIONS = {"frictionless 39.8": dict(model="frictionless", v_col=39.8, arms=li
                                      arms=["base", "dt 0.014"])}
 #: the question whose base runs are read against the paper protocol's at larger sizes
 TREND = "frictionless 39.8"
-#: where the paper-size and 2 x 5000 runs of the same protocol keep their records
+#: where the paper-size and 2 x 5000 runs of the same protocol keep their records, and
+#: where their continuations to the fixed end keep theirs (``fixed_end``)
 PROTOCOL_RECORDS = HERE / "paper_protocol" / "records"
+CONTINUED = HERE / "fixed_end" / "records"
 
 
 def twelfth(b2: float) -> int:
@@ -134,15 +139,21 @@ def arm_summary(rows: list[dict], key: str = "f_gro") -> dict:
 
 def size_rows(runs: list[dict]) -> dict:
     """f_near of the paper-protocol question b (39.8 m/s, frictionless) per size, from its
-    runs among ``dissipation_runs``."""
+    runs among ``dissipation_runs``, each read where its outcome is decided (``readings``;
+    an open offset is listed in ``open`` and leaves f_near unknown), and as the settle rule
+    ended them (``per_offset_settle_end``)."""
     out = {}
     for n in sorted({r["N_tar"] for r in runs if r["source"] == "paper_protocol"}):
         rows = [r for r in runs if r["source"] == "paper_protocol" and r["N_tar"] == n]
-        offsets = {r["b2_twelfths"] for r in rows}
-        by_offset = {k: float(np.mean([r["f_gro"] for r in rows if r["b2_twelfths"] == k]))
-                     for k in sorted(offsets)}
+        offsets = sorted({r["b2_twelfths"] for r in rows})
+        mean = lambda key, k: float(np.mean([r[key] for r in rows if r["b2_twelfths"] == k]))  # noqa: E731
+        open_ = [k for k in offsets if any(r["f_gro_read"] is None for r in rows
+                                            if r["b2_twelfths"] == k)]
+        by_offset = {k: mean("f_gro_read", k) for k in offsets if k not in open_}
         out[n] = dict(per_offset={f"{k}/12": v for k, v in by_offset.items()},
-                      f_near=f_near(by_offset) if offsets == set(WEIGHT) else None,
+                      open=[f"{k}/12" for k in open_],
+                      f_near=f_near(by_offset) if set(by_offset) == set(WEIGHT) else None,
+                      per_offset_settle_end={f"{k}/12": mean("f_gro", k) for k in offsets},
                       seeds=sorted({r["seed"] for r in rows}))
     return out
 
@@ -162,11 +173,14 @@ def dissipation_runs(records: Path, protocol_records: Path) -> list[dict]:
         o = json.loads(path.read_text())
         if o.get("stop_reason") not in COMPLETE or twelfth(o["B_off"] ** 2) not in WEIGHT:
             continue
+        reading = read(o, path.parent, CONTINUED / path.parent.relative_to(protocol_records),
+                       PAPER_CAP_TC) if source == "paper_protocol" else {}
         frames = read_csv(path.parent / rundir.FRAMES)
         r_c = np.sqrt(5 / 3) * frames[0]["gyration_radius_largest"]
         n = o["n_total"]
         out.append(dict(source=source, N_tar=o["N_tar"], b2_twelfths=twelfth(o["B_off"] ** 2), seed=o["seed"],
                         f_gro=o["growth_efficiency"], E_dis=o["dissipated_fraction"],
+                        f_gro_read=reading.get("f_gro"), read_at=reading.get("read_at"),
                         kinetic_left=o["kinetic_left"], N_con=o["N_con"] / n,
                         N_cut=o["N_cut"] / n, singles=o["diagnostics"]["N_cum_1"] / n,
                         r_c_over_r1=r_c / o["radius"],
@@ -237,7 +251,7 @@ def figure(summary: dict, results: Path) -> list[Path]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, (a, b) = plt.subplots(1, 2, figsize=(11.5, 4.4))
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11.5, 5.4))
     n = summary["plan"]["n"]
     trend = summary["asked"][TREND]["arms"]
     for i, (name, s) in enumerate(trend.items()):
@@ -249,12 +263,19 @@ def figure(summary: dict, results: Path) -> list[Path]:
     for size, s in summary["sizes"].items():
         ks = [int(k.split("/")[0]) for k in s["per_offset"]]
         a.plot(ks, list(s["per_offset"].values()), "k--" if size == "5000" else "k-",
-               marker="s", label=f"2 x {size}: paper protocol, seeds {s['seeds']}")
+               marker="s", label=f"2 x {size}: paper protocol, seeds {s['seeds']}, read "
+                                 "where decided" + (f" ({', '.join(s['open'])} open)"
+                                                    if s["open"] else ""))
+        moved = [(int(k.split("/")[0]), v) for k, v in s["per_offset_settle_end"].items()
+                 if s["per_offset"].get(k) != v]
+        if moved:
+            a.plot(*zip(*moved), "x", color="0.45", ms=7,
+                   label=f"2 x {size}: where the settle rule (shape not watched) ended it")
     a.axhline(0, color="0.6", lw=0.8)
     a.set_xlabel("B_off^2 (twelfths)")
     a.set_ylabel("f_gro")
     a.set_title(f"{TREND} m/s, undamped: f_gro by offset and size")
-    a.legend(fontsize=7)
+    a.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2)
     names, vals = [], []
     for q, compared in summary["results"].items():
         for name, c in compared.items():
