@@ -324,6 +324,14 @@ def test_the_paper_protocol_study_averages_twelve_offsets_and_keeps_every_record
     assert m["mean"] == pytest.approx(np.mean(list(per_seed.values())), abs=1e-12)
     assert m["se"] == pytest.approx(abs(per_seed[1] - per_seed[2]) / 2, abs=1e-12)
     assert b["sign_open"] is None
+    # the same runs on the other studies' four offsets 0, 3/12, 6/12, 9/12, by their
+    # quadrature: the trapezoid with 9/12's value held to B_off^2 = 1
+    four = b["mean_f_gro_four_offsets"]
+    for seed in (1, 2):
+        f = {round(12 * float(r["B_off"]) ** 2): r["growth_efficiency"] for r in runs
+             if r["question"] == "b" and r["seed"] == seed}
+        want = np.trapezoid([f[0], f[3], f[6], f[9], f[9]], [0, 0.25, 0.5, 0.75, 1.0])
+        assert four["per_seed"][str(seed)] == pytest.approx(want, abs=1e-12)
     # with offsets still to run, what they must average for <f_gro> < 0: eq. (1) weighs
     # each inner twelfth 1/12, so with 4/12, 5/12 and 7/12 open they weigh 3/12, and the
     # run offsets with the open ones at that average give <f_gro> = 0
@@ -760,6 +768,15 @@ def test_each_paper_size_record_is_read_where_its_outcome_is_decided():
     assert big["per_offset"]["1/12"] == pytest.approx(-0.272, abs=1e-3)
     assert big["per_offset_settle_end"]["1/12"] > 0.8
     assert big["open"] == ["3/12"] and big["f_near"] is None
+    # the paper's "N_cut exceeds N_tot from 10 to 100 m/s" (undamped frictionless) fails
+    # at the paper's size only where the two aggregates pass: 11/12 broke 0.87 N_tot, and
+    # the committed statement names that run as its exception
+    o, _, _ = reading(11)
+    assert o["diagnostics"]["N_cut"] / o["n_total"] == pytest.approx(0.873, abs=1e-3)
+    said = json.loads((ROOT / "validation" / "paper_protocol" / "summary.json").read_text())
+    row = next(s for s in said["results"]["statements"] if "N_cut > N_tot" in s["paper"])
+    assert not row["holds"] and row["measured"].endswith(
+        "at or below N_tot at 39.8 m/s, B_off^2 11/12 (2 x 50000, seed 1)")
 
 
 def test_a_stopped_campaign_keeps_the_records_of_the_runs_it_finished(tmp_path):

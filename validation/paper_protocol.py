@@ -17,6 +17,11 @@ no collision), with its diagnostics (N_con, N_cut, E_dis by channel, N_cum: ever
       f_gro about 1 with E_dis,tot about E_imp (App. C.1), one campaign per model
   f   all four models at 10 m/s on four offsets (seed 1): N_con < N_tot for the frictional
       models, N_cut well below N_tot for all but the undamped frictionless (App. C.2)
+  g   frictional, undamped, 63.1 m/s, the paper's twelve offsets: <f_gro> about 0 (v_fra
+      60 m/s), where four offsets ended by the settle rule without shape gave +0.12 at
+      2 x 5000 (``vfra_size``: v_fra 82 m/s); asked at 2 x 5000, where that rise with N is
+      seen, it tells the grid of offsets from the end of the run (``mean_f_gro_four_offsets``
+      reads the same runs on the four offsets)
 
 e and f are there for the paper's statements (``statements``: every statement of App. C
 that gives a number or a sign, one row each, read at each speed at the largest size that
@@ -65,7 +70,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bpca3d_models import MODELS, model_spec
+from bpca3d_models import FULL as OTHER_STUDIES, MODELS, model_spec
 from common import (HERE, all_kept, campaign_study_parser, run_campaigns, save, study_paths,
                     write_summary)
 from jkrdt import protocol, rundir
@@ -101,6 +106,8 @@ QUESTIONS = {
     "f": dict(model=tuple(MODELS), v_col=10.0, b_off2=[0.0, 0.25, 0.5, 0.75], seeds=[1],
               paper="frictional: N_con < N_tot; all but the undamped frictionless: N_cut "
                     "well below N_tot (App. C.2, Figs. C.3, C.4)"),
+    "g": dict(model="frictional", v_col=63.1, b_off2=TWELFTHS_FIRST,
+              paper="<f_gro> about 0 at v_fra = 60 m/s, below 0 above it (Sect. 3.1, Fig. 2)"),
 }
 
 
@@ -291,6 +298,11 @@ def question_summary(runs: list[dict], twelve: bool) -> dict:
     out["read"] = read_summary(runs, twelve)
     if out["paper_grid"]:
         out["mean_f_gro"] = seed_scatter(runs, f_gro, protocol.GRAZING["growth_efficiency"])
+        # the same runs on the other studies' four offsets, by their quadrature (the last
+        # value held to B_off^2 = 1): what the offsets' grid alone moves <f_gro> by
+        four = [o for o in runs
+                if any(abs(o["B_off"] ** 2 - b) < 1e-6 for b in OTHER_STUDIES["b_off2"])]
+        out["mean_f_gro_four_offsets"] = seed_scatter(four, f_gro)
         out["means"] = mean_diagnostics(runs)
         out["mean_f_gro_at_us"] = {
             t: seed_scatter(runs, lambda o: o["f_gro_at_us"][t],
@@ -376,6 +388,12 @@ def statements(rows: list[dict]) -> list[dict]:
         x = [r[name] / r["n_total"] for r in runs]
         return f"{name} / N_tot {min(x):.2f} to {max(x):.2f}" if runs else None
 
+    def below(runs, name):    # the runs where a count the paper puts above N_tot is not
+        low = [r for r in runs if r[name] <= r["n_total"]]
+        return "; at or below N_tot at " + ", ".join(
+            f"{r['v_col']:g} m/s, B_off^2 {round(12 * r['B_off'] ** 2)}/12 "
+            f"(2 x {r['N_tar']}, seed {r['seed']})" for r in low) if low else ""
+
     def speeds(runs):
         return " at " + ", ".join(f"{v:g}" for v in sorted({r["v_col"] for r in runs})) + \
             " m/s" if runs else ""
@@ -386,11 +404,12 @@ def statements(rows: list[dict]) -> list[dict]:
         what = "undamped" if name == "frictionless" else "damped"
         out.append(row(f"frictionless, {what}: N_con > N_tot for 10 <= v_col <= 100 m/s "
                        f"(App. C.2, Fig. C.3{fig})", fl,
-                       (per_grain(fl, "N_con") or "") + speeds(fl),
+                       (per_grain(fl, "N_con") or "") + speeds(fl) + below(fl, "N_con"),
                        all(r["N_con"] > r["n_total"] for r in fl)))
     fl = [r for r in pick(rows, "frictionless") if collided(r)]
     out.append(row("frictionless, undamped: N_cut > N_tot for 10 <= v_col <= 100 m/s "
-                   "(App. C.2, Fig. C.4c)", fl, (per_grain(fl, "N_cut") or "") + speeds(fl),
+                   "(App. C.2, Fig. C.4c)", fl,
+                   (per_grain(fl, "N_cut") or "") + speeds(fl) + below(fl, "N_cut"),
                    all(r["N_cut"] > r["n_total"] for r in fl)))
     out.append(row("frictionless, undamped: E_dis,c = E_dis,tot (App. C.1, Fig. C.2c)", fl,
                    f"E_dis,c / E_dis,tot {min(r['E_dis_c'] / r['E_dis_tot'] for r in fl):.4f}"
