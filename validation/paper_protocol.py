@@ -545,12 +545,19 @@ def figure(summary: dict, results: Path) -> list[Path]:
                            label=f"<f_gro> so read {r['mean_f_gro']['mean']:+.3f}")
             for b in r["open"]:
                 ax.annotate("open", (b, -0.95), fontsize=6, ha="center", color="C3")
+            need = r.get("sign_open")
+            if need:
+                ax.annotate(f"so read, <f_gro> < 0 needs {', '.join(need['to_run'])}\n"
+                            f"to {'average' if len(need['to_run']) > 1 else 'read'} below "
+                            f"{need['rest_must_average_below']:+.3f}",
+                            (0.98, 0.4), fontsize=6, ha="right", color="C3")
         if s.get("mean_f_gro"):
             ax.plot([1.0], [protocol.GRAZING["growth_efficiency"]], "o", mfc="none",
                     color="k", ms=5, label="12/12 grazes: taken as 0")
             m = s["mean_f_gro"]
-            ax.axhline(m["mean"], color="C3", ls="--",
-                       label=f"<f_gro> (eq. 1) {m['mean']:+.3f} +- {m['se']:.3f}")
+            scatter = f" +- {m['se']:.3f}" if np.isfinite(m["se"]) else ", one seed"
+            ax.axhline(m["mean"], color="k", ls="--",
+                       label=f"<f_gro> (eq. 1) where they ended {m['mean']:+.3f}{scatter}")
         ax.axhline(0, color="0.8", lw=0.8)
         ax.set_ylim(-1.05, 1.05)
         ax.set_xlim(-0.03, 1.03)
