@@ -777,6 +777,19 @@ def test_each_paper_size_record_is_read_where_its_outcome_is_decided():
     row = next(s for s in said["results"]["statements"] if "N_cut > N_tot" in s["paper"])
     assert not row["holds"] and row["measured"].endswith(
         "at or below N_tot at 39.8 m/s, B_off^2 11/12 (2 x 50000, seed 1)")
+    # the paper-size scenes that vfra_size ran first on four offsets are paired with
+    # their runs here; over those four, eq. (1)'s trapezoid of this study's ends is the
+    # four-offset mean of question b, and the earlier runs' is vfra_size's own
+    same = said["results"]["same_scenes_in_vfra_size"]
+    b50 = said["results"]["by_question"]["b"]["50000"]
+    assert same["four_offsets"]["b"]["1"]["here"] == pytest.approx(
+        b50["mean_f_gro_four_offsets"]["per_seed"]["1"], abs=1e-12)
+    earlier = {round(12 * p["B_off2"]): p["earlier"]["f_gro"] for p in same["pairs"]
+               if p["question"] == "b"}
+    assert sorted(earlier) == [0, 3, 6, 9]
+    assert same["four_offsets"]["b"]["1"]["earlier"] == pytest.approx(np.trapezoid(
+        [earlier[0], earlier[3], earlier[6], earlier[9], earlier[9]],
+        [0, 0.25, 0.5, 0.75, 1.0]), abs=1e-12)
 
 
 def test_a_stopped_campaign_keeps_the_records_of_the_runs_it_finished(tmp_path):

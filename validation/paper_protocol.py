@@ -343,6 +343,44 @@ FRICTIONAL = ("frictional", "frictional, T_vis 6 ps")
 FRICTIONLESS = ("frictionless", "frictionless, T_vis 6 ps")
 
 
+#: the runs of ``vfra_size`` (four offsets, the settle rule of their time, shape not
+#: watched); c and g ask some of its 2 x 5000 scenes again: the same aggregates, dt and rule
+EARLIER = HERE / "vfra_size" / "runs.csv"
+
+
+def same_scenes_earlier(rows: list[dict], earlier: Path = EARLIER) -> dict:
+    """Each run here whose collision ``vfra_size`` ran too (the same model, size, speed,
+    offset and seed), with both runs' ends, and per question and seed the two studies' <f_gro>
+    over the four offsets where both have them all: where a run here ends later than the
+    earlier one, at another f_gro, the end of the run moved it (here the rule watches shape
+    unless the campaign began without it)."""
+    if not earlier.exists():
+        return dict(pairs=[], four_offsets={})
+    before = {(r["model"], int(r["size"]), r["v_col"], round(r["B_off"], 9), int(r["seed"])): r
+              for r in read_csv(earlier)}
+    pairs, runs = [], defaultdict(list)
+    for r in rows:
+        e = before.get((r["model_name"], r["N_tar"], r["v_col"], round(r["B_off"], 9),
+                        r["seed"]))
+        if e is None:
+            continue
+        pairs.append(dict(question=r["question"], N_tar=r["N_tar"], v_col=r["v_col"],
+                          B_off2=round(r["B_off"] ** 2, 4), seed=r["seed"],
+                          earlier=dict(f_gro=e["growth_efficiency"], stop_step=int(e["stop_step"])),
+                          here=dict(f_gro=r["growth_efficiency"], stop_step=r["stop_step"],
+                                    read_at=r["read_at"], f_gro_read=r["f_gro_read"])))
+        runs[(r["question"], r["seed"])].append((r["B_off"], e["growth_efficiency"],
+                                                 r["growth_efficiency"]))
+    four = {}
+    for (question, seed), got in sorted(runs.items()):
+        b = np.array([x[0] ** 2 for x in got])
+        if all(np.any(np.abs(b - k) < 1e-6) for k in OTHER_STUDIES["b_off2"]):
+            four.setdefault(question, {})[str(seed)] = dict(
+                earlier=float(b_off_average(b, [x[1] for x in got])),
+                here=float(b_off_average(b, [x[2] for x in got])))
+    return dict(pairs=pairs, four_offsets=four)
+
+
 def pick(rows: list[dict], model=None, v=None, b2=None) -> list[dict]:
     """The runs of ``model`` (a MODELS name or several) at ``v`` and ``b2`` (None: any), at
     each speed those of the largest size that ran it."""
@@ -637,7 +675,8 @@ def summarise(records: Path, results: Path, plot: bool = True,
                                       for k in QUESTIONS},
                 records=str(records.relative_to(results)) if records.is_relative_to(results)
                 else str(records),
-                results=dict(by_question=summary, statements=statements(rows)),
+                results=dict(by_question=summary, statements=statements(rows),
+                             same_scenes_in_vfra_size=same_scenes_earlier(rows)),
                 ended_at_cap=ended_at_cap(outcomes), left_out=left_out(loaded))
     if plot and summary:
         done["figures"] = [p.name for p in figure(summary, results)]
