@@ -726,6 +726,31 @@ def test_the_fixed_end_study_continues_settled_runs_as_the_same_collision(tmp_pa
     assert [m["record"] for m in summary["not_at_hand"]] == [first["record"]]
     assert summary["not_at_hand"][0]["twelfths"] == 0
     assert "--questions a --again 0" in said
+    # with --anew it is continued all the same, as another run of the same collision: its
+    # own small record goes in the continuation's (anew/), and it is read on from its own
+    # checks, not the record's: at the fixed end, f_gro that of the continuation's last
+    # check, whatever the altered record says
+    said = subprocess.run([sys.executable, str(ROOT / "validation" / "fixed_end.py"), "--quick",
+                           "--anew", "--runs", str(tmp_path / "fixed" / "runs"), "--results",
+                           str(results), "--protocol-runs", str(tmp_path / "protocol" / "runs"),
+                           "--protocol-records", str(protocol_results / "records")],
+                          check=True, capture_output=True, text=True, timeout=600).stdout
+    assert f"{second['record']}: not the run recorded (n_largest" in said
+    kept = results / "records" / second["record"]
+    run = tmp_path / "protocol" / "runs" / second["record"]
+    assert (kept / "anew" / "outcome.json").read_text() == (run / "outcome.json").read_text()
+    assert (kept / "anew" / "checks.csv").read_text() == (run / "checks.csv").read_text()
+    sys.path.insert(0, str(ROOT / "validation"))
+    from paper_protocol import QUICK_CAP_TC
+    from readings import read
+
+    last = read_csv(kept / "checks.csv")[-1]
+    r = read(json.loads(outcome.read_text()), outcome.parent, kept, QUICK_CAP_TC)
+    assert r["anew"] and r["read_at"] == "fixed end"
+    assert r["f_gro"] == (last["n_largest"] - 24) / 24
+    row = next(x for x in json.loads((results / "summary.json").read_text())["results"][
+        "offsets"] if x["record"] == second["record"])
+    assert row["anew"] and row["f_gro_fixed_end"] == r["f_gro"]
 
 
 def test_each_paper_size_record_is_read_where_its_outcome_is_decided():

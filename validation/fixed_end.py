@@ -14,6 +14,8 @@ f_gro is read at one fixed end for every offset (a run that hit the cap is there
                                              # a later call without --shape goes on from
                                              # there to the fixed end, the record extended
     ./run validate fixed_end --summary-only  # the results from the records kept so far
+    ./run validate fixed_end --anew          # ... a run made anew that is not the one
+                                             # recorded too, as another run of its collision
 
 Continuations run one at a time over --np ranks, in the protocol's order of offsets
 (``paper_protocol.TWELFTHS_FIRST``), each in RUNS/<campaign>/ (a second call resumes a cut-off one from its newer
@@ -49,7 +51,7 @@ from jkrdt.analysis.summary import b_off_average, b_off_groups
 from jkrdt.stopping import SettleRule
 from paper_protocol import (PAPER_CAP_TC, QUESTIONS, QUICK_CAP_TC, SNAPSHOTS_US,
                             TWELFTHS_FIRST, what_the_rest_needs)
-from readings import RULE, checks_through, continued_after, first_at, fixed_end_us
+from readings import ANEW, RULE, anew, checks_through, first_at, fixed_end_us
 
 HERE = Path(__file__).resolve().parent
 #: a settle window no run reaches: the checks are written, the rule never ends the run
@@ -190,7 +192,7 @@ def offsets(records: Path, kept: Path, campaigns: str, cap_tc: float) -> list[di
         fixed_us = fixed_end_us(outcome.parent, cap_tc)
         shape = stretching(own, RULE.window, RULE.tolerance)     # None: one grain
         more = kept / where / rundir.CHECKS
-        checks = own + continued_after(own, kept / where, o["N_tar"], o["N_pro"])
+        checks = checks_through(outcome.parent, kept / where, o["N_tar"], o["N_pro"])
         t = [r["time"] * 1e6 for r in checks]
         f = [r["growth_efficiency"] for r in checks]
         at = first_at(checks, fixed_us)
@@ -201,7 +203,7 @@ def offsets(records: Path, kept: Path, campaigns: str, cap_tc: float) -> list[di
                         N_tar=o["N_tar"], stop_reason=o["stop_reason"], end_us=end_us,
                         f_gro_end=o["growth_efficiency"],
                         r_g_change_at_end=shape and shape["r_g_growth"],
-                        continued=more.exists(),
+                        continued=more.exists(), anew=anew(kept / where),
                         fixed_us=fixed_us, fixed_end_us=t[at], f_gro_fixed_end=f[at],
                         reaches_fixed_end=reaches,
                         # continued with shape watched (--shape), settled before the end
@@ -266,7 +268,7 @@ def table(rows: list[dict], done: dict) -> list[str]:
         fixed = (f"{r['f_gro_fixed_end']:+.3f}" + ("" if r["continued"] or r["stop_reason"]
                                                    != "settled" else " (not continued)")
                  + (f" (settled with shape watched at {r['fixed_end_us']:.2f} us)"
-                    if r["shape_end"] else ""))
+                    if r["shape_end"] else "") + (" (a run made anew)" if r["anew"] else ""))
         stretch = ("      -" if r["r_g_change_at_end"] is None
                    else f"{100 * r['r_g_change_at_end']:+6.2f} %")
         lines.append(f"  {protocol.twelfths(r['B_off2'], 1e-3):7s}  {r['stop_reason']:8s} "
@@ -318,6 +320,10 @@ def main(argv=None) -> int:
                         "its largest body has stopped stretching and its counts hold, or at "
                         "the fixed end (validation/end_rule.py measured that end against "
                         "the fixed end on every run continued there)")
+    p.add_argument("--anew", action="store_true",
+                   help="continue a run made anew (paper_protocol --again) even where it is "
+                        "not the recorded one (another build: chaos parts the two), as "
+                        "another run of the same collision, read from its own checks")
     p.add_argument("--summary-only", action="store_true")
     p.add_argument("--one", nargs=2, type=Path, help=argparse.SUPPRESS)
     args = p.parse_args(argv)
@@ -344,11 +350,19 @@ def main(argv=None) -> int:
                 keep(runs / where, kept / where)
                 continue
             differs = not_the_record(run, args.protocol_records / where)
-            if differs:
+            if differs and not args.anew:
                 print(f"{where}: not continued: this run is not the one recorded "
                       f"({differs}), so its continuation would not extend the record's "
-                      "checks", flush=True)
+                      "checks; --anew continues it as another run of the same collision, "
+                      "read from its own checks", flush=True)
                 continue
+            if differs:     # its own small record in the continuation's, before the mark
+                (kept / where / ANEW).mkdir(parents=True, exist_ok=True)
+                for name in rundir.RECORD:
+                    if (run / name).exists():
+                        shutil.copy2(run / name, kept / where / ANEW / name)
+                print(f"{where}: not the run recorded ({differs}): continued as another "
+                      "run of the same collision", flush=True)
             cmd = [str(BIN / "python"), __file__, "--one", str(run), str(runs / where),
                    "--cap", str(args.cap)] + (["--shape"] if args.shape else [])
             if args.np > 1:

@@ -34,7 +34,8 @@ paper's 2 x 50000 where the placement says it decides something (``--stage paper
 (``RUNS/n<N>_<question>_b2_<B_off^2>``), in the order of QUESTIONS; a second call resumes
 them, and a campaign whose runs all have their records kept is not run again, on this
 machine or a new one (``--again K`` runs the offset K/12 anew, bit for bit on the same
-build and ranks, for ``fixed_end`` to continue). Every run ends by the settle rule, its
+build and ranks, for ``fixed_end`` to continue; on another build it is another run of the
+same collision, which ``fixed_end --anew`` continues and reads on its own). Every run ends by the settle rule, its
 dt chosen by ``--dt auto`` for max |dE| / E_imp <= 1e-3 (vfra_size.TOLERANCE); at the
 paper's size a run that has not settled by PAPER_CAP_TC ends there and is averaged at
 its end (``summary.json``'s ``ended_at_cap`` lists each with how far its f_gro moved over

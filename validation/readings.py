@@ -15,6 +15,11 @@ not stretching there. Each kept record is read, in this order, at:
               its outcome is not known, and it is left out of every reading's average
 
 The f_gro of each is (N_lar - N_tar) / N_pro at that check of the run's settle checks.
+
+A continuation may be of a run made anew that is not the recorded one (``paper_protocol
+--again`` on another build: chaos parts the two within thousands of steps). Its record
+then holds that run's own small record (ANEW/), and the continuation is read on from that
+run's checks, not the recorded run's: another run of the same collision.
 """
 
 from __future__ import annotations
@@ -32,13 +37,25 @@ RULE = SettleRule()
 #: how a record can be read, in the order above; OPEN is not a reading
 FIXED_END, SHAPE_END, CAP, SETTLE_END, OPEN = ("fixed end", "shape end", "cap",
                                                "settle end", "open")
+#: in a continuation's record: the small record of the run made anew that it continued,
+#: where that run is not the recorded one
+ANEW = "anew"
 
 
 def checks_through(record: Path, continued: Path | None, n_tar: int, n_pro: int) -> list[dict]:
     """The settle checks of the run of ``record`` (rows of ``from_checks``), with those of
-    its continuation's record ``continued`` after its end appended where one is kept."""
-    rows = from_checks(read_csv(record / rundir.CHECKS), n_tar, n_pro)
+    its continuation's record ``continued`` after its end appended where one is kept; the
+    continuation's alone, whole, where it continued a run made anew (``anew``)."""
+    own = continued / ANEW if anew(continued) else record
+    rows = from_checks(read_csv(own / rundir.CHECKS), n_tar, n_pro)
     return rows + continued_after(rows, continued, n_tar, n_pro)
+
+
+def anew(continued: Path | None) -> bool:
+    """Whether the continuation's record ``continued`` is of a run made anew that is not
+    the recorded one (its own record then lies in ANEW/)."""
+    return continued is not None and (continued / ANEW / rundir.OUTCOME).exists() and \
+        (continued / rundir.CHECKS).exists()
 
 
 def continued_after(rows: list[dict], continued: Path | None, n_tar: int,
@@ -73,7 +90,8 @@ def read(outcome: dict, record: Path, continued: Path | None, cap_tc: float) -> 
         at = first_at(rows, fixed_end_us(record, cap_tc))
         last = rows[-1 if at is None else at]
         return dict(read_at=SHAPE_END if at is None else FIXED_END,
-                    f_gro=last["growth_efficiency"], time_us=last["time"] * 1e6)
+                    f_gro=last["growth_efficiency"], time_us=last["time"] * 1e6,
+                    **(dict(anew=True) if anew(continued) else {}))
     if outcome.get("stop_reason") == "cap":
         return dict(end, read_at=CAP)
     rows = checks_through(record, None, outcome["N_tar"], outcome["N_pro"])
