@@ -182,12 +182,14 @@ def offsets(records: Path, kept: Path, campaigns: str, cap_tc: float) -> list[di
     fixed end ``cap_tc`` (the first check at or after it, as a cap ends a run: one capped
     later is read there too); how it ended, and how much the largest fragment's gyration
     radius grew over the settle rule's last window there (a body still being pulled apart
-    by a neck, which the rule does not watch)."""
+    by a neck, which the rule does not watch). Where the continuation is of a run made
+    anew (``readings.anew``), the row is that run's: its own end, checks and continuation."""
     out = []
     for outcome in sorted(records.glob(f"{campaigns}/v*/b2_*/seed*/{rundir.OUTCOME}")):
-        o = json.loads(outcome.read_text())
         where = outcome.parent.relative_to(records)
-        own = checks_through(outcome.parent, None, o["N_tar"], o["N_pro"])
+        run = kept / where / ANEW if anew(kept / where) else outcome.parent
+        o = json.loads((run / rundir.OUTCOME).read_text())
+        own = checks_through(run, None, o["N_tar"], o["N_pro"])
         end_us = own[-1]["time"] * 1e6
         fixed_us = fixed_end_us(outcome.parent, cap_tc)
         shape = stretching(own, RULE.window, RULE.tolerance)     # None: one grain

@@ -351,15 +351,18 @@ EARLIER = HERE / "vfra_size" / "runs.csv"
 
 def same_scenes_earlier(rows: list[dict], earlier: Path = EARLIER) -> dict:
     """Each run here whose collision ``vfra_size`` ran too (the same model, size, speed,
-    offset and seed), with both runs' ends, and per question and seed the two studies' <f_gro>
-    over the four offsets where both have them all: where a run here ends later than the
-    earlier one, at another f_gro, the end of the run moved it (here the rule watches shape
-    unless the campaign began without it)."""
+    offset and seed), with both runs' ends; and per question, size and seed where
+    ``vfra_size`` has all four of its offsets, eq. (1)'s trapezoid over them (the last value
+    held to 1) of its runs (``earlier``), of this study's where it ran all four (``here``),
+    and of its runs with this study's readings where it decided an offset (``read``, those
+    offsets in ``read_here``): where a run here ends later than the earlier one, at another
+    f_gro, the end of the run moved it (here the rule watches shape unless the campaign
+    began without it)."""
     if not earlier.exists():
         return dict(pairs=[], four_offsets={})
     before = {(r["model"], int(r["size"]), r["v_col"], round(r["B_off"], 9), int(r["seed"])): r
               for r in read_csv(earlier)}
-    pairs, runs = [], defaultdict(list)
+    pairs, groups = [], defaultdict(dict)
     for r in rows:
         e = before.get((r["model_name"], r["N_tar"], r["v_col"], round(r["B_off"], 9),
                         r["seed"]))
@@ -370,15 +373,26 @@ def same_scenes_earlier(rows: list[dict], earlier: Path = EARLIER) -> dict:
                           earlier=dict(f_gro=e["growth_efficiency"], stop_step=int(e["stop_step"])),
                           here=dict(f_gro=r["growth_efficiency"], stop_step=r["stop_step"],
                                     read_at=r["read_at"], f_gro_read=r["f_gro_read"])))
-        runs[(r["question"], r["seed"])].append((r["B_off"], e["growth_efficiency"],
-                                                 r["growth_efficiency"]))
-    four = {}
-    for (question, seed), got in sorted(runs.items()):
-        b = np.array([x[0] ** 2 for x in got])
-        if all(np.any(np.abs(b - k) < 1e-6) for k in OTHER_STUDIES["b_off2"]):
-            four.setdefault(question, {})[str(seed)] = dict(
-                earlier=float(b_off_average(b, [x[1] for x in got])),
-                here=float(b_off_average(b, [x[2] for x in got])))
+        cell = (str(r["N_tar"]) if len(models_of(r["question"])) == 1     # as by_question
+                else f"{r['N_tar']}, {r['model_name']}")
+        groups[(r["question"], cell, r["seed"])][round(r["B_off"] ** 2, 6)] = r
+    four, b2s = {}, list(OTHER_STUDIES["b_off2"])
+    for (question, cell, seed), mine in sorted(groups.items()):
+        r = next(iter(mine.values()))
+        first = [before.get((r["model_name"], r["N_tar"], r["v_col"], round(float(np.sqrt(b2)), 9),
+                             seed))
+                 for b2 in b2s]
+        if any(e is None for e in first):
+            continue
+        here = [mine.get(round(b2, 6)) for b2 in b2s]
+        decided = [h is not None and h["f_gro_read"] is not None for h in here]
+        entry = dict(earlier=float(b_off_average(b2s, [e["growth_efficiency"] for e in first])),
+                     read=float(b_off_average(b2s, [h["f_gro_read"] if d else e["growth_efficiency"]
+                                                    for h, d, e in zip(here, decided, first)])),
+                     read_here=[protocol.twelfths(b2) for b2, d in zip(b2s, decided) if d])
+        if all(h is not None for h in here):
+            entry["here"] = float(b_off_average(b2s, [h["growth_efficiency"] for h in here]))
+        four.setdefault(question, {}).setdefault(cell, {})[str(seed)] = entry
     return dict(pairs=pairs, four_offsets=four)
 
 
