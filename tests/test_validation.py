@@ -836,6 +836,17 @@ def test_each_paper_size_record_is_read_where_its_outcome_is_decided():
     assert read_four == pytest.approx(np.trapezoid([f[0], f[3], f[6], f[9], f[9]],
                                                    [0, 0.25, 0.5, 0.75, 1.0]), abs=1e-12)
     assert read_four > 0 > got
+    # g, the undamped frictional model at 63.1 m/s on the twelve offsets at 2 x 5000 (two
+    # seeds): <f_gro> of each seed eq. (1)'s trapezoid, about 0 (the paper's v_fra 60 m/s),
+    # below the same runs' four-offset mean and the four-offset mean of vfra_size's runs
+    g = said["results"]["by_question"]["g"]["5000"]
+    for seed in ("1", "2"):
+        f = [g["f_gro_per_seed"][f"{j / 12:.4f}"][seed] for j in range(12)]
+        assert g["mean_f_gro"]["per_seed"][seed] == pytest.approx(
+            np.trapezoid(f + [0.0], k), abs=1e-12)
+        assert g["mean_f_gro"]["per_seed"][seed] < g["mean_f_gro_four_offsets"]["per_seed"][
+            seed] < same["four_offsets"]["g"]["5000"][seed]["earlier"]
+    assert g["mean_f_gro"]["mean"] == pytest.approx(0.0087, abs=1e-4)
     assert same["four_offsets"]["b"]["50000"]["1"]["earlier"] == pytest.approx(np.trapezoid(
         [earlier[0], earlier[3], earlier[6], earlier[9], earlier[9]],
         [0, 0.25, 0.5, 0.75, 1.0]), abs=1e-12)
