@@ -184,15 +184,25 @@ def keep_records(campaign: Path, records: Path) -> list[Path]:
         to = records / run.relative_to(campaign)
         if (to / rundir.OUTCOME).exists() or not rundir.finished(run):
             continue
-        to.mkdir(parents=True, exist_ok=True)
-        for name in rundir.RECORD:
-            if (run / name).exists() and name != rundir.OUTCOME:
-                shutil.copy2(run / name, to / name)
-        shutil.copy2(outcome, to / rundir.OUTCOME)
+        copy_record(run, to)
         kept.append(to)
     if spec.exists() and records.exists() and not (records / SPEC_RECORD).exists():
         shutil.copy2(spec, records / SPEC_RECORD)
     return kept
+
+
+def copy_record(run: Path, to: Path) -> None:
+    """The small record (``jkrdt.rundir.RECORD``) of the finished run ``run`` copied to
+    ``to``, its outcome.json last, so that a record with an outcome is whole."""
+    import shutil
+
+    from jkrdt import rundir
+
+    to.mkdir(parents=True, exist_ok=True)
+    for name in rundir.RECORD:
+        if (run / name).exists() and name != rundir.OUTCOME:
+            shutil.copy2(run / name, to / name)
+    shutil.copy2(run / rundir.OUTCOME, to / rundir.OUTCOME)
 
 
 def save(fig, results: Path, stem: str) -> list[Path]:

@@ -39,7 +39,7 @@ from jkrdt.analysis.outcome import from_checks, stretching as stretching_at
 from jkrdt.analysis.tables import read_csv
 from jkrdt.stopping import SettleRule
 from paper_protocol import PAPER_CAP_TC
-from readings import ANEW, anew
+from readings import ANEW, continued_run
 
 HERE = Path(__file__).resolve().parent
 #: the rules tried: (W checks, c of N_tot); (5, 1e-4) is the settle rule's own counts
@@ -145,16 +145,16 @@ def watched_shape(rule: SettleRule = SettleRule()) -> dict:
             if more.parent.name == ANEW:     # the run made anew inside a continuation's
                 continue
             record = records / more.parent.relative_to(kept)
-            own = more.parent / ANEW if anew(more.parent) else record    # the run continued
+            first = read_csv(continued_run(record, more.parent) / rundir.CHECKS)
             meta = rundir.read_metadata(record)
             t_c = rundir.from_metadata(meta).scales.t_c
-            raw = read_csv(own / rundir.CHECKS) + read_csv(more)
+            raw = first + read_csv(more)
             contacts = {int(r["step"]): int(r["contacts"]) for r in raw}    # last written
             rows = from_checks(raw, meta["N_tar"], meta["N_pro"])
             for r in rows:
                 r["contacts"] = contacts[r["step"]]
             end = next(k for k, r in enumerate(rows)
-                       if r["step"] == int(read_csv(own / rundir.CHECKS)[-1]["step"]))
+                       if r["step"] == int(first[-1]["step"]))
             run = dict(run=named(record), N_tar=meta["N_tar"], B_off2=round(meta["B_off"] ** 2, 4),
                        seed=meta["seed"], settle_end_us=rows[end]["time"] * 1e6,
                        f_gro_settle_end=rows[end]["growth_efficiency"],

@@ -44,14 +44,14 @@ import subprocess
 import sys
 from pathlib import Path
 
-from common import BIN, campaign_study_parser, save, study_paths, write_summary
+from common import BIN, campaign_study_parser, copy_record, save, study_paths, write_summary
 from jkrdt import protocol, rundir
 from jkrdt.analysis.outcome import stretching
 from jkrdt.analysis.summary import b_off_average, b_off_groups
 from jkrdt.stopping import SettleRule
 from paper_protocol import (PAPER_CAP_TC, QUESTIONS, QUICK_CAP_TC, SNAPSHOTS_US,
                             TWELFTHS_FIRST, what_the_rest_needs)
-from readings import ANEW, RULE, anew, checks_through, first_at, fixed_end_us
+from readings import ANEW, RULE, anew, checks_through, continued_run, first_at, fixed_end_us
 
 HERE = Path(__file__).resolve().parent
 #: a settle window no run reaches: the checks are written, the rule never ends the run
@@ -187,7 +187,7 @@ def offsets(records: Path, kept: Path, campaigns: str, cap_tc: float) -> list[di
     out = []
     for outcome in sorted(records.glob(f"{campaigns}/v*/b2_*/seed*/{rundir.OUTCOME}")):
         where = outcome.parent.relative_to(records)
-        run = kept / where / ANEW if anew(kept / where) else outcome.parent
+        run = continued_run(outcome.parent, kept / where)
         o = json.loads((run / rundir.OUTCOME).read_text())
         own = checks_through(run, None, o["N_tar"], o["N_pro"])
         end_us = own[-1]["time"] * 1e6
@@ -359,10 +359,7 @@ def main(argv=None) -> int:
                       "read from its own checks", flush=True)
                 continue
             if differs:     # its own small record in the continuation's, before the mark
-                (kept / where / ANEW).mkdir(parents=True, exist_ok=True)
-                for name in rundir.RECORD:
-                    if (run / name).exists():
-                        shutil.copy2(run / name, kept / where / ANEW / name)
+                copy_record(run, kept / where / ANEW)
                 print(f"{where}: not the run recorded ({differs}): continued as another "
                       "run of the same collision", flush=True)
             cmd = [str(BIN / "python"), __file__, "--one", str(run), str(runs / where),

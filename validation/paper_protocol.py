@@ -71,7 +71,8 @@ from pathlib import Path
 
 import numpy as np
 
-from bpca3d_models import FULL as OTHER_STUDIES, MODELS, model_spec
+from b_off_grid import FOUR, one_of_four
+from bpca3d_models import MODELS, model_spec
 from common import (HERE, all_kept, campaign_study_parser, run_campaigns, save, study_paths,
                     write_summary)
 from jkrdt import protocol, rundir
@@ -301,9 +302,8 @@ def question_summary(runs: list[dict], twelve: bool) -> dict:
         out["mean_f_gro"] = seed_scatter(runs, f_gro, protocol.GRAZING["growth_efficiency"])
         # the same runs on the other studies' four offsets, by their quadrature (the last
         # value held to B_off^2 = 1): what the offsets' grid alone moves <f_gro> by
-        four = [o for o in runs
-                if any(abs(o["B_off"] ** 2 - b) < 1e-6 for b in OTHER_STUDIES["b_off2"])]
-        out["mean_f_gro_four_offsets"] = seed_scatter(four, f_gro)
+        out["mean_f_gro_four_offsets"] = seed_scatter(
+            [o for o in runs if one_of_four(o["B_off"] ** 2)], f_gro)
         out["means"] = mean_diagnostics(runs)
         out["mean_f_gro_at_us"] = {
             t: seed_scatter(runs, lambda o: o["f_gro_at_us"][t],
@@ -373,11 +373,9 @@ def same_scenes_earlier(rows: list[dict], earlier: Path = EARLIER) -> dict:
                           earlier=dict(f_gro=e["growth_efficiency"], stop_step=int(e["stop_step"])),
                           here=dict(f_gro=r["growth_efficiency"], stop_step=r["stop_step"],
                                     read_at=r["read_at"], f_gro_read=r["f_gro_read"])))
-        cell = (str(r["N_tar"]) if len(models_of(r["question"])) == 1     # as by_question
-                else f"{r['N_tar']}, {r['model_name']}")
-        groups[(r["question"], cell, r["seed"])][round(r["B_off"] ** 2, 6)] = r
-    four, b2s = {}, list(OTHER_STUDIES["b_off2"])
-    for (question, cell, seed), mine in sorted(groups.items()):
+        groups[(r["question"], str(cell(r)), r["seed"])][round(r["B_off"] ** 2, 6)] = r
+    four, b2s = {}, list(FOUR)
+    for (question, size, seed), mine in sorted(groups.items()):
         r = next(iter(mine.values()))
         first = [before.get((r["model_name"], r["N_tar"], r["v_col"], round(float(np.sqrt(b2)), 9),
                              seed))
@@ -392,7 +390,7 @@ def same_scenes_earlier(rows: list[dict], earlier: Path = EARLIER) -> dict:
                      read_here=[protocol.twelfths(b2) for b2, d in zip(b2s, decided) if d])
         if all(h is not None for h in here):
             entry["here"] = float(b_off_average(b2s, [h["growth_efficiency"] for h in here]))
-        four.setdefault(question, {}).setdefault(cell, {})[str(seed)] = entry
+        four.setdefault(question, {}).setdefault(size, {})[str(seed)] = entry
     return dict(pairs=pairs, four_offsets=four)
 
 

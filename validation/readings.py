@@ -46,8 +46,8 @@ def checks_through(record: Path, continued: Path | None, n_tar: int, n_pro: int)
     """The settle checks of the run of ``record`` (rows of ``from_checks``), with those of
     its continuation's record ``continued`` after its end appended where one is kept; the
     continuation's alone, whole, where it continued a run made anew (``anew``)."""
-    own = continued / ANEW if anew(continued) else record
-    rows = from_checks(read_csv(own / rundir.CHECKS), n_tar, n_pro)
+    rows = from_checks(read_csv(continued_run(record, continued) / rundir.CHECKS), n_tar,
+                       n_pro)
     return rows + continued_after(rows, continued, n_tar, n_pro)
 
 
@@ -56,6 +56,12 @@ def anew(continued: Path | None) -> bool:
     the recorded one (its own record then lies in ANEW/)."""
     return continued is not None and (continued / ANEW / rundir.OUTCOME).exists() and \
         (continued / rundir.CHECKS).exists()
+
+
+def continued_run(record: Path, continued: Path | None) -> Path:
+    """The record of the run that the continuation ``continued`` goes on from: the run
+    made anew in it (``anew``), else ``record``'s own."""
+    return continued / ANEW if anew(continued) else record
 
 
 def continued_after(rows: list[dict], continued: Path | None, n_tar: int,
